@@ -1,0 +1,1 @@
+"""igen-lerobot."""

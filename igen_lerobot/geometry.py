@@ -1,0 +1,119 @@
+"""Poses in one convention, so sim, generation, ICP and the Franka agree.
+
+Convention (used everywhere in igen-lerobot):
+
+* A pose is a 4x4 homogeneous transform ``T_parent_child`` (float64) mapping points in the child
+  frame to the parent frame: ``p_parent = T_parent_child @ p_child``. Names carry both frames,
+  e.g. ``T_world_eef``, ``T_world_obj``.
+* Quaternions are **scalar-last** ``(x, y, z, w)``, as in scipy and robosuite. MuJoCo's native
+  scalar-first ``(w, x, y, z)`` is converted only at the simulator boundary
+  (:func:`quat_wxyz_to_xyzw`).
+* Positions are in metres.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+__all__ = [
+    "make_pose",
+    "pose_inv",
+    "pose_to_pos_quat",
+    "pos_quat_to_pose",
+    "quat_wxyz_to_xyzw",
+    "quat_xyzw_to_wxyz",
+    "rotation_angle",
+    "transform_segment",
+    "interpolate_poses",
+]
+
+
+def make_pose(pos: np.ndarray, rot: np.ndarray | None = None) -> np.ndarray:
+    """4x4 pose from a position [m] and a 3x3 rotation (identity if omitted)."""
+    pose = np.eye(4)
+    pose[:3, 3] = np.asarray(pos, dtype=float)
+    if rot is not None:
+        pose[:3, :3] = np.asarray(rot, dtype=float)
+    return pose
+
+
+def pose_inv(pose: np.ndarray) -> np.ndarray:
+    """Inverse of a rigid transform (or a stack of them), without a general matrix inverse."""
+    pose = np.asarray(pose, dtype=float)
+    inv = np.zeros_like(pose)
+    rot_t = np.swapaxes(pose[..., :3, :3], -1, -2)
+    inv[..., :3, :3] = rot_t
+    inv[..., :3, 3] = -np.einsum("...ij,...j->...i", rot_t, pose[..., :3, 3])
+    inv[..., 3, 3] = 1.0
+    return inv
+
+
+def pose_to_pos_quat(pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Split a pose (or stack) into position [m] and quaternion (x, y, z, w)."""
+    pose = np.asarray(pose, dtype=float)
+    quat = Rotation.from_matrix(pose[..., :3, :3]).as_quat()
+    return pose[..., :3, 3].copy(), quat
+
+
+def pos_quat_to_pose(pos: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
+    """Pose (or stack) from position [m] and quaternion (x, y, z, w); the quaternion is normalised."""
+    pos = np.asarray(pos, dtype=float)
+    quat = np.asarray(quat_xyzw, dtype=float)
+    rot = Rotation.from_quat(quat).as_matrix()
+    pose = np.zeros(pos.shape[:-1] + (4, 4))
+    pose[..., :3, :3] = rot
+    pose[..., :3, 3] = pos
+    pose[..., 3, 3] = 1.0
+    return pose
+
+
+def quat_wxyz_to_xyzw(quat_wxyz: np.ndarray) -> np.ndarray:
+    """MuJoCo (scalar-first) to our scalar-last order."""
+    return np.roll(np.asarray(quat_wxyz, dtype=float), -1, axis=-1)
+
+
+def quat_xyzw_to_wxyz(quat_xyzw: np.ndarray) -> np.ndarray:
+    """Our scalar-last order to MuJoCo (scalar-first)."""
+    return np.roll(np.asarray(quat_xyzw, dtype=float), 1, axis=-1)
+
+
+def rotation_angle(rot_a: np.ndarray, rot_b: np.ndarray) -> float:
+    """Geodesic angle [rad] between two rotation matrices."""
+    rel = np.asarray(rot_a).T @ np.asarray(rot_b)
+    cos = np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)
+    return float(np.arccos(cos))
+
+
+def transform_segment(
+    T_world_eef_src: np.ndarray, T_world_obj_src: np.ndarray, T_world_obj_new: np.ndarray
+) -> np.ndarray:
+    """Move a source end-effector path into a new object frame (MimicGen's transform).
+
+    Keeps every pose's relation to the object fixed:
+    ``T_new_eef = T_new_obj · inv(T_src_obj) · T_src_eef``.
+
+    Args:
+        T_world_eef_src: (N, 4, 4) source end-effector poses.
+        T_world_obj_src: (4, 4) pose of the object the segment is relative to, in the source.
+        T_world_obj_new: (4, 4) pose of the same object in the new scene.
+    """
+    T_new_src = np.asarray(T_world_obj_new, dtype=float) @ pose_inv(T_world_obj_src)
+    return np.einsum("ij,njk->nik", T_new_src, np.asarray(T_world_eef_src, dtype=float))
+
+
+def interpolate_poses(T_start: np.ndarray, T_end: np.ndarray, num_steps: int) -> np.ndarray:
+    """``num_steps`` poses strictly after ``T_start`` up to and including ``T_end``.
+
+    Positions are interpolated linearly and rotations by slerp, the way MimicGen bridges the
+    robot's current pose and the start of a transformed segment.
+    """
+    if num_steps < 1:
+        raise ValueError(f"num_steps must be >= 1 to reach the target pose, got {num_steps}")
+    fractions = np.arange(1, num_steps + 1) / num_steps
+    pos = (1.0 - fractions)[:, None] * T_start[:3, 3] + fractions[:, None] * T_end[:3, 3]
+    slerp = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([T_start[:3, :3], T_end[:3, :3]])))
+    out = np.tile(np.eye(4), (num_steps, 1, 1))
+    out[:, :3, :3] = slerp(fractions).as_matrix()
+    out[:, :3, 3] = pos
+    return out

@@ -1,0 +1,20 @@
+"""igen simulated tasks as a LeRobot env plugin.
+
+LeRobot imports every installed distribution whose name starts with ``lerobot_env_`` (see
+``lerobot.utils.import_utils.register_third_party_plugins``); importing this package registers
+our env configs (``--env.type=block_grasp``) and their gymnasium ids. It imports neither MuJoCo
+nor robosuite: those load when an env is built.
+"""
+
+import gymnasium as gym
+
+from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
+
+__all__ = ["BlockGraspEnvConfig"]
+
+_GYM_ENTRY_POINT = "igen_lerobot.gym_env:TaskGymEnv"
+
+for _config_cls in (BlockGraspEnvConfig,):
+    _gym_id = f"lerobot_env_igen/{_config_cls.task}"
+    if _gym_id not in gym.registry:
+        gym.register(id=_gym_id, entry_point=_GYM_ENTRY_POINT, disable_env_checker=True)

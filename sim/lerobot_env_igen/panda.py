@@ -1,0 +1,174 @@
+"""A Panda arm with its gripper inside a compiled scene: reset, control period, contacts.
+
+Control: every control period holds one Cartesian goal and runs ``substeps`` physics steps of
+2 ms, computing OSC torques at each (``mj_step1`` -> torques -> ``mj_step2``, as robosuite does).
+The gripper is a binary command rate-limited like robosuite's Panda gripper controller.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numba
+import numpy as np
+
+from lerobot_env_igen.osc import OperationalSpaceController, OscGains, orientation_error
+from lerobot_env_igen.scene import SceneNames
+
+# World orientation of the end effector the tasks hold: approach axis down, fingers along world y.
+TOP_DOWN_ROT = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+GRIPPER_RATE = 0.2  # change of the normalised finger command per control period (robosuite's)
+FINGER_OPEN = 0.04  # [m] per finger
+
+
+@numba.njit(cache=True)
+def _pair_mask(pairs, mask_a, mask_b):  # pragma: no cover - compiled
+    out = np.zeros(pairs.shape[0], dtype=np.bool_)
+    for i in range(pairs.shape[0]):
+        g1, g2 = pairs[i, 0], pairs[i, 1]
+        out[i] = (mask_a[g1] and mask_b[g2]) or (mask_a[g2] and mask_b[g1])
+    return out
+
+
+def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: tuple[str, ...]) -> np.ndarray:
+    return np.array([mujoco.mj_name2id(model, kind, n) for n in names])
+
+
+class PandaArm:
+    """Owns the MjData of a Panda scene and steps it under OSC."""
+
+    def __init__(self, model: mujoco.MjModel, default_qpos: np.ndarray, home_pos: np.ndarray,
+                 control_hz: int, names: SceneNames = SceneNames(), gains: OscGains = OscGains()) -> None:
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self.names = names
+        obj = mujoco.mjtObj
+        arm_joints = _ids(model, obj.mjOBJ_JOINT, names.arm_joints)
+        finger_joints = _ids(model, obj.mjOBJ_JOINT, names.finger_joints)
+        self.arm_qpos = model.jnt_qposadr[arm_joints]
+        self.arm_dofs = model.jnt_dofadr[arm_joints]
+        self.finger_qpos = model.jnt_qposadr[finger_joints]
+        self.arm_act = _ids(model, obj.mjOBJ_ACTUATOR, names.arm_actuators)
+        self.finger_act = _ids(model, obj.mjOBJ_ACTUATOR, names.finger_actuators)
+        self.site = mujoco.mj_name2id(model, obj.mjOBJ_SITE, names.eef_site)
+        self.substeps = int(round(1.0 / control_hz / model.opt.timestep))
+        if self.substeps < 1:
+            raise ValueError(f"control_hz={control_hz} is faster than the physics step {model.opt.timestep} s")
+        self.gripper_geoms = self._gripper_geom_ids()
+        self.gripper_geom_mask = self.geom_mask(self.gripper_geoms)
+        self.home_qpos = self._solve_home(default_qpos, np.asarray(home_pos, float))
+        self.osc = OperationalSpaceController(model, self.site, self.arm_dofs, self.home_qpos, self.arm_qpos, gains)
+        self.goal_pos = np.zeros(3)
+        self.goal_rot = TOP_DOWN_ROT.copy()
+        self._gripper_level = -1.0  # -1 open ... +1 closed
+
+    # ------------------------------------------------------------------ kinematics
+    def _gripper_geom_ids(self) -> np.ndarray:
+        """All collision geoms of the hand and fingers (bodies under the gripper root)."""
+        root = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, self.names.gripper_body_root)
+        bodies = {root}
+        for b in range(self.model.nbody):
+            parent = self.model.body_parentid[b]
+            if parent in bodies or b in bodies:
+                bodies.add(b)
+        # Hand links above the gripper root touch objects too (the Panda hand).
+        hand = self.model.body_parentid[root]
+        bodies.add(hand)
+        geoms = [g for g in range(self.model.ngeom)
+                 if self.model.geom_bodyid[g] in bodies and self.model.geom_contype[g] | self.model.geom_conaffinity[g]]
+        return np.array(sorted(geoms))
+
+    def _solve_home(self, start_qpos: np.ndarray, target_pos: np.ndarray) -> np.ndarray:
+        """Joint configuration with the end effector top-down at ``target_pos`` (damped least squares)."""
+        data = mujoco.MjData(self.model)
+        data.qpos[self.arm_qpos] = start_qpos
+        jacp, jacr = np.zeros((3, self.model.nv)), np.zeros((3, self.model.nv))
+        for _ in range(200):
+            mujoco.mj_kinematics(self.model, data)
+            pos = data.site_xpos[self.site]
+            rot = data.site_xmat[self.site].reshape(3, 3)
+            err = np.concatenate([target_pos - pos, orientation_error(TOP_DOWN_ROT, rot)])
+            if np.linalg.norm(err) < 1e-6:
+                break
+            mujoco.mj_comPos(self.model, data)
+            mujoco.mj_jacSite(self.model, data, jacp, jacr, self.site)
+            jac = np.concatenate([jacp[:, self.arm_dofs], jacr[:, self.arm_dofs]])
+            dq = jac.T @ np.linalg.solve(jac @ jac.T + 1e-4 * np.eye(6), err)
+            data.qpos[self.arm_qpos] += dq
+        return data.qpos[self.arm_qpos].copy()
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Arm at home, fingers open, everything at rest (objects are placed by the task)."""
+        mujoco.mj_resetData(self.model, self.data)
+        self.data.qpos[self.arm_qpos] = self.home_qpos
+        self.data.qpos[self.finger_qpos] = (FINGER_OPEN, -FINGER_OPEN)
+        self._gripper_level = -1.0
+        self._apply_gripper_ctrl()
+        mujoco.mj_forward(self.model, self.data)
+        self.goal_pos = self.data.site_xpos[self.site].copy()
+        self.goal_rot = TOP_DOWN_ROT.copy()
+
+    def eef_pose(self) -> np.ndarray:
+        pose = np.eye(4)
+        pose[:3, :3] = self.data.site_xmat[self.site].reshape(3, 3)
+        pose[:3, 3] = self.data.site_xpos[self.site]
+        return pose
+
+    def eef_pos(self) -> np.ndarray:
+        return self.data.site_xpos[self.site].copy()
+
+    def eef_quat_xyzw(self) -> np.ndarray:
+        quat_wxyz = np.empty(4)
+        mujoco.mju_mat2Quat(quat_wxyz, self.data.site_xmat[self.site])
+        return np.array([quat_wxyz[1], quat_wxyz[2], quat_wxyz[3], quat_wxyz[0]])
+
+    def gripper_width(self) -> float:
+        q = self.data.qpos[self.finger_qpos]
+        return float(q[0] - q[1])
+
+    # ------------------------------------------------------------------ control
+    def _apply_gripper_ctrl(self) -> None:
+        opening = FINGER_OPEN * 0.5 * (1.0 - self._gripper_level)  # level -1 -> open, +1 -> closed
+        self.data.ctrl[self.finger_act] = (opening, -opening)
+
+    def geom_mask(self, geoms: np.ndarray) -> np.ndarray:
+        """Boolean lookup over all geoms, for cheap contact tests inside the substep loop."""
+        mask = np.zeros(self.model.ngeom, dtype=bool)
+        mask[np.asarray(geoms, dtype=int)] = True
+        return mask
+
+    def control_period(self, goal_pos: np.ndarray, close_gripper: bool, touch_mask: np.ndarray | None = None) -> bool:
+        """Hold ``goal_pos`` (and the top-down orientation) for one control period.
+
+        Returns whether the gripper touched any geom in ``touch_mask`` (see :meth:`geom_mask`)
+        at any substep of the period.
+        """
+        self.goal_pos = np.asarray(goal_pos, dtype=float)
+        step = GRIPPER_RATE if close_gripper else -GRIPPER_RATE
+        self._gripper_level = min(1.0, max(-1.0, self._gripper_level + step))
+        self._apply_gripper_ctrl()
+        model, data, act = self.model, self.data, self.arm_act
+        touched = False
+        for _ in range(self.substeps):
+            mujoco.mj_step1(model, data)
+            data.ctrl[act] = self.osc.torques(data, self.goal_pos, self.goal_rot)
+            mujoco.mj_step2(model, data)
+            if touch_mask is not None and not touched:
+                touched = self.touching(touch_mask)
+        return touched
+
+    def _contact_mask(self, obj_mask: np.ndarray) -> np.ndarray:
+        pairs = self.data.contact.geom[: self.data.ncon]
+        return _pair_mask(pairs, self.gripper_geom_mask, obj_mask)
+
+    def touching(self, obj_mask: np.ndarray) -> bool:
+        """Whether the gripper is in contact with any geom in ``obj_mask`` now."""
+        if self.data.ncon == 0:
+            return False
+        return bool(self._contact_mask(obj_mask).any())
+
+    def contact_points(self, obj_mask: np.ndarray) -> np.ndarray:
+        """World positions (k, 3) of the gripper's current contacts with geoms in ``obj_mask``."""
+        if self.data.ncon == 0:
+            return np.zeros((0, 3))
+        return self.data.contact.pos[: self.data.ncon][self._contact_mask(obj_mask)].copy()
