@@ -41,5 +41,9 @@ class Operator(abc.ABC):
     def act(self, env: TaskEnv) -> np.ndarray:
         """The operator's action for the next step."""
 
+    def ends_episode(self) -> bool:
+        """Whether the operator asked to stop the episode now (e.g. a teleop 'quit' key)."""
+        return False
+
     def close(self) -> None:  # noqa: B027 - optional hook
         """Release devices."""

@@ -22,7 +22,7 @@ from igen_lerobot.exceptions import ConfigError
 __all__ = ["PoseNoise", "BoxNoise", "RadialNoise", "NoNoise", "Reveal"]
 
 
-class Reveal(str, enum.Enum):
+class Reveal(enum.StrEnum):
     """What the robot learns about an object's pose on contact with it."""
 
     NONE = "none"  # the belief stays corrupted for the whole episode

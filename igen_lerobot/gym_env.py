@@ -23,8 +23,13 @@ class TaskGymEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
 
-    def __init__(self, config: TaskEnvConfig, render_mode: str | None = "rgb_array",
-                 render_camera: str = "frontview", render_size: int = 256) -> None:
+    def __init__(
+        self,
+        config: TaskEnvConfig,
+        render_mode: str | None = "rgb_array",
+        render_camera: str = "frontview",
+        render_size: int = 256,
+    ) -> None:
         self.config = config
         self.task_env = config.make_task_env()
         spec = self.task_env.spec
@@ -34,17 +39,21 @@ class TaskGymEnv(gym.Env):
         self.task_description = spec.instruction
         self.task = spec.name
         inf = np.float32(np.inf)
-        self.observation_space = gym.spaces.Dict({
-            "agent_pos": gym.spaces.Box(-inf, inf, (len(spec.state_names),), np.float32),
-            "environment_state": gym.spaces.Box(-inf, inf, (len(spec.env_state_names),), np.float32),
-        })
+        self.observation_space = gym.spaces.Dict(
+            {
+                "agent_pos": gym.spaces.Box(-inf, inf, (len(spec.state_names),), np.float32),
+                "environment_state": gym.spaces.Box(-inf, inf, (len(spec.env_state_names),), np.float32),
+            }
+        )
         low, high = self.task_env.action_bounds()
         self.action_space = gym.spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
 
     @staticmethod
     def _to_gym(obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        return {"agent_pos": obs[OBS_STATE].astype(np.float32),
-                "environment_state": obs[OBS_ENV_STATE].astype(np.float32)}
+        return {
+            "agent_pos": obs[OBS_STATE].astype(np.float32),
+            "environment_state": obs[OBS_ENV_STATE].astype(np.float32),
+        }
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)

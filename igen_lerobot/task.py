@@ -121,7 +121,7 @@ class TaskEnv(abc.ABC):
     @property
     @abc.abstractmethod
     def corruption(self) -> np.ndarray:
-        """This episode's pose error per object, flattened like ``spec.corruption_names`` [m]."""
+        """The current episode's pose error per object, flattened like ``spec.corruption_names`` [m]."""
 
     @abc.abstractmethod
     def action_towards(self, T_world_eef_target: np.ndarray, gripper_closed: bool) -> np.ndarray:

@@ -40,13 +40,30 @@ _RIDGE = 1e-8
 
 
 @numba.njit(cache=True)
-def _osc_kernel(jacp, jacr, mass_full, d0, n, qvel_all, qpos_arm, bias_all, pos, rot,
-                goal_pos, goal_rot, kp, kd, home, kp_null, kd_null):  # pragma: no cover - compiled
+def _osc_kernel(
+    jacp,
+    jacr,
+    mass_full,
+    d0,
+    n,
+    qvel_all,
+    qpos_arm,
+    bias_all,
+    pos,
+    rot,
+    goal_pos,
+    goal_rot,
+    kp,
+    kd,
+    home,
+    kp_null,
+    kd_null,
+):  # pragma: no cover - compiled
     jac = np.empty((6, n))
-    jac[:3] = jacp[:, d0:d0 + n]
-    jac[3:] = jacr[:, d0:d0 + n]
-    mass = np.ascontiguousarray(mass_full[d0:d0 + n, d0:d0 + n])
-    qvel = qvel_all[d0:d0 + n].copy()
+    jac[:3] = jacp[:, d0 : d0 + n]
+    jac[3:] = jacr[:, d0 : d0 + n]
+    mass = np.ascontiguousarray(mass_full[d0 : d0 + n, d0 : d0 + n])
+    qvel = qvel_all[d0 : d0 + n].copy()
     twist = jac @ qvel
     a = goal_rot @ rot.T
     err = np.empty(6)
@@ -65,7 +82,7 @@ def _osc_kernel(jacp, jacr, mass_full, d0, n, qvel_all, qpos_arm, bias_all, pos,
     wrench = np.empty(6)
     wrench[:3] = lam_pos @ desired[:3]
     wrench[3:] = lam_ori @ desired[3:]
-    tau = jac.T @ wrench + bias_all[d0:d0 + n]
+    tau = jac.T @ wrench + bias_all[d0 : d0 + n]
     jbar = mass_inv @ jac.T @ lam_full
     null = np.eye(n) - jbar @ jac
     pose_torque = mass @ (kp_null * (home - qpos_arm) - kd_null * qvel)
@@ -75,8 +92,15 @@ def _osc_kernel(jacp, jacr, mass_full, d0, n, qvel_all, qpos_arm, bias_all, pos,
 class OperationalSpaceController:
     """Torques that drive a site to a goal pose; the arm's dofs must be contiguous."""
 
-    def __init__(self, model: mujoco.MjModel, site_id: int, dof_ids: np.ndarray, home_qpos: np.ndarray,
-                 qpos_ids: np.ndarray, gains: OscGains = OscGains()) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        site_id: int,
+        dof_ids: np.ndarray,
+        home_qpos: np.ndarray,
+        qpos_ids: np.ndarray,
+        gains: OscGains | None = None,
+    ) -> None:
         dof_ids, qpos_ids = np.asarray(dof_ids), np.asarray(qpos_ids)
         for label, ids in (("dof", dof_ids), ("qpos", qpos_ids)):
             if not np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids))):
@@ -86,6 +110,7 @@ class OperationalSpaceController:
         self._d0, self._n = int(dof_ids[0]), len(dof_ids)
         self._qpos = slice(int(qpos_ids[0]), int(qpos_ids[0]) + len(qpos_ids))
         self._home = np.asarray(home_qpos, dtype=float)
+        gains = gains or OscGains()
         self._kp = np.array([gains.kp_pos] * 3 + [gains.kp_ori] * 3)
         self._kd = 2.0 * np.sqrt(self._kp) * gains.damping_ratio
         self._kp_null = float(gains.kp_null)
@@ -99,7 +124,21 @@ class OperationalSpaceController:
         mujoco.mj_jacSite(self._model, data, self._jacp, self._jacr, self._site)
         mujoco.mj_fullM(self._model, self._mass_full, data.qM)
         return _osc_kernel(
-            self._jacp, self._jacr, self._mass_full, self._d0, self._n, data.qvel, data.qpos[self._qpos],
-            data.qfrc_bias, data.site_xpos[self._site], data.site_xmat[self._site].reshape(3, 3),
-            goal_pos, goal_rot, self._kp, self._kd, self._home, self._kp_null, self._kd_null,
+            self._jacp,
+            self._jacr,
+            self._mass_full,
+            self._d0,
+            self._n,
+            data.qvel,
+            data.qpos[self._qpos],
+            data.qfrc_bias,
+            data.site_xpos[self._site],
+            data.site_xmat[self._site].reshape(3, 3),
+            goal_pos,
+            goal_rot,
+            self._kp,
+            self._kd,
+            self._home,
+            self._kp_null,
+            self._kd_null,
         )

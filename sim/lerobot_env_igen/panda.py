@@ -18,6 +18,8 @@ from lerobot_env_igen.scene import SceneNames
 TOP_DOWN_ROT = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 GRIPPER_RATE = 0.2  # change of the normalised finger command per control period (robosuite's)
 FINGER_OPEN = 0.04  # [m] per finger
+SCENE_NAMES = SceneNames()
+DEFAULT_GAINS = OscGains()
 
 
 @numba.njit(cache=True)
@@ -36,8 +38,15 @@ def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: tuple[str, ...]) -> 
 class PandaArm:
     """Owns the MjData of a Panda scene and steps it under OSC."""
 
-    def __init__(self, model: mujoco.MjModel, default_qpos: np.ndarray, home_pos: np.ndarray,
-                 control_hz: int, names: SceneNames = SceneNames(), gains: OscGains = OscGains()) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        default_qpos: np.ndarray,
+        home_pos: np.ndarray,
+        control_hz: int,
+        names: SceneNames = SCENE_NAMES,
+        gains: OscGains = DEFAULT_GAINS,
+    ) -> None:
         self.model = model
         self.data = mujoco.MjData(model)
         self.names = names
@@ -73,8 +82,11 @@ class PandaArm:
         # Hand links above the gripper root touch objects too (the Panda hand).
         hand = self.model.body_parentid[root]
         bodies.add(hand)
-        geoms = [g for g in range(self.model.ngeom)
-                 if self.model.geom_bodyid[g] in bodies and self.model.geom_contype[g] | self.model.geom_conaffinity[g]]
+        geoms = [
+            g
+            for g in range(self.model.ngeom)
+            if self.model.geom_bodyid[g] in bodies and self.model.geom_contype[g] | self.model.geom_conaffinity[g]
+        ]
         return np.array(sorted(geoms))
 
     def _solve_home(self, start_qpos: np.ndarray, target_pos: np.ndarray) -> np.ndarray:

@@ -37,7 +37,9 @@ class SceneNames:
     gripper_body_root: str = "gripper0_right_right_gripper"
 
 
-def build_panda_table_scene(boxes: dict[str, tuple[float, tuple[float, float, float, float]]]) -> tuple[mujoco.MjModel, np.ndarray]:
+def build_panda_table_scene(
+    boxes: dict[str, tuple[float, tuple[float, float, float, float]]],
+) -> tuple[mujoco.MjModel, np.ndarray]:
     """Compile a Panda + table + free boxes scene.
 
     Args:

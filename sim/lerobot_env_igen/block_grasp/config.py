@@ -31,14 +31,20 @@ class BlockGraspEnvConfig(TaskEnvConfig):
     max_delta: float = 0.03  # [m] per-step clip on the commanded end-effector displacement
     render_camera: str = "frontview"
     render_size: int = 256
-    features: dict[str, PolicyFeature] = field(default_factory=lambda: {
-        ACTION: PolicyFeature(type=FeatureType.ACTION, shape=(len(SPEC.action_names),)),
-        "agent_pos": PolicyFeature(type=FeatureType.STATE, shape=(len(SPEC.state_names),)),
-        "environment_state": PolicyFeature(type=FeatureType.ENV, shape=(len(SPEC.env_state_names),)),
-    })
-    features_map: dict[str, str] = field(default_factory=lambda: {
-        ACTION: ACTION, "agent_pos": OBS_STATE, "environment_state": OBS_ENV_STATE,
-    })
+    features: dict[str, PolicyFeature] = field(
+        default_factory=lambda: {
+            ACTION: PolicyFeature(type=FeatureType.ACTION, shape=(len(SPEC.action_names),)),
+            "agent_pos": PolicyFeature(type=FeatureType.STATE, shape=(len(SPEC.state_names),)),
+            "environment_state": PolicyFeature(type=FeatureType.ENV, shape=(len(SPEC.env_state_names),)),
+        }
+    )
+    features_map: dict[str, str] = field(
+        default_factory=lambda: {
+            ACTION: ACTION,
+            "agent_pos": OBS_STATE,
+            "environment_state": OBS_ENV_STATE,
+        }
+    )
 
     def __post_init__(self) -> None:
         if self.fps != SPEC.fps:
@@ -52,8 +58,12 @@ class BlockGraspEnvConfig(TaskEnvConfig):
 
     @property
     def gym_kwargs(self) -> dict:
-        return {"config": self, "render_camera": self.render_camera, "render_size": self.render_size,
-                "max_episode_steps": self.episode_length}
+        return {
+            "config": self,
+            "render_camera": self.render_camera,
+            "render_size": self.render_size,
+            "max_episode_steps": self.episode_length,
+        }
 
     @property
     def task_spec(self) -> TaskSpec:
@@ -62,8 +72,9 @@ class BlockGraspEnvConfig(TaskEnvConfig):
     def make_task_env(self) -> TaskEnv:
         from lerobot_env_igen.block_grasp.env import BlockGraspEnv
 
-        return BlockGraspEnv(corruption=self.corruption, reveal=self.reveal, cube_region=self.cube_region,
-                             max_delta=self.max_delta)
+        return BlockGraspEnv(
+            corruption=self.corruption, reveal=self.reveal, cube_region=self.cube_region, max_delta=self.max_delta
+        )
 
     def make_scripted_operator(self) -> Operator:
         from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator

@@ -63,9 +63,14 @@ class BlockGraspEnv(TaskEnv):
         cube_joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "cube_joint0")
         self._cube_qpos = model.jnt_qposadr[cube_joint]
         self._cube_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "cube_main")
-        cube_geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == self._cube_body and model.geom_contype[g]]
+        cube_geoms = [
+            g for g in range(model.ngeom) if model.geom_bodyid[g] == self._cube_body and model.geom_contype[g]
+        ]
         self._cube_mask = self.arm.geom_mask(cube_geoms)
-        pads = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in (self.arm.names.left_pad, self.arm.names.right_pad)]
+        pads = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n)
+            for n in (self.arm.names.left_pad, self.arm.names.right_pad)
+        ]
         self._pad_ids = pads
         self._rest_z = TABLE_TOP_Z + CUBE_HALF
         self._offset = np.zeros(3)
@@ -93,7 +98,9 @@ class BlockGraspEnv(TaskEnv):
     def _checked_corruption(self, corruption: np.ndarray) -> np.ndarray:
         corruption = np.asarray(corruption, dtype=float).reshape(-1)
         if corruption.shape != (3,):
-            raise ConfigError(f"corruption override must be (dx, dy, dz) [m] for the cube, got shape {corruption.shape}")
+            raise ConfigError(
+                f"corruption override must be (dx, dy, dz) [m] for the cube, got shape {corruption.shape}"
+            )
         return corruption
 
     def step(self, action: np.ndarray) -> StepInfo:

@@ -1,0 +1,75 @@
+"""Config of ``igen-collect`` (draccus, LeRobot style: ``--env.type=block_grasp --mode=demos``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lerobot.envs.configs import EnvConfig
+from lerobot.teleoperators.config import TeleoperatorConfig
+
+from igen_lerobot.env_config import TaskEnvConfig
+from igen_lerobot.exceptions import ConfigError
+
+MODES = ("demos", "interventions")
+OPERATORS = ("scripted", "teleop")
+BASE_POLICIES = ("scripted",)
+
+
+@dataclass
+class DatasetOutputConfig:
+    """Where a new dataset goes."""
+
+    repo_id: str | None = None  # default: local/<task>_<mode>
+    root: str | None = None  # default: outputs/datasets/<repo name>
+    overwrite: bool = False  # replace an existing dataset at root (only once the new one is complete)
+
+    def resolve(self, default_name: str) -> tuple[str, Path]:
+        repo_id = self.repo_id or f"local/{default_name}"
+        if repo_id.count("/") != 1:
+            raise ConfigError(f"dataset.repo_id must look like 'user/name', got {repo_id!r}")
+        root = Path(self.root) if self.root else Path("outputs/datasets") / repo_id.split("/")[1]
+        return repo_id, root
+
+
+@dataclass
+class CollectConfig:
+    """Record source episodes into a LeRobot dataset with intervention flags."""
+
+    env: EnvConfig | None = None
+    mode: str = "interventions"  # "demos": operator on true poses; "interventions": human-gated
+    num_episodes: int = 10
+    seed: int = 0
+    max_attempts: int = 0  # attempts before giving up (0: 5 x num_episodes)
+    operator: str = "scripted"  # "scripted" (sees true poses) or "teleop" (a person, --teleop.type=...)
+    teleop: TeleoperatorConfig | None = None
+    teleop_step: float = 0.01  # [m] end-effector displacement per teleop step
+    base_policy: str = "scripted"  # the policy the operator corrects in interventions mode
+    dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
+
+    def __post_init__(self) -> None:
+        if self.env is None:
+            raise ConfigError("--env.type is required, e.g. --env.type=block_grasp")
+        if not isinstance(self.env, TaskEnvConfig):
+            raise ConfigError(
+                f"--env.type={self.env.type} is a LeRobot env but not an igen task; "
+                "use an igen task such as block_grasp"
+            )
+        if self.mode not in MODES:
+            raise ConfigError(f"--mode must be one of {MODES}, got {self.mode!r}")
+        if self.operator not in OPERATORS:
+            raise ConfigError(f"--operator must be one of {OPERATORS}, got {self.operator!r}")
+        if self.operator == "teleop" and self.teleop is None:
+            raise ConfigError(
+                "--operator=teleop needs a device, e.g. --teleop.type=keyboard_ee or --teleop.type=gamepad"
+            )
+        if self.base_policy not in BASE_POLICIES:
+            raise ConfigError(f"--base_policy must be one of {BASE_POLICIES}, got {self.base_policy!r}")
+        if self.num_episodes < 1:
+            raise ConfigError(f"--num_episodes must be >= 1, got {self.num_episodes}")
+        if self.max_attempts < 0:
+            raise ConfigError(f"--max_attempts must be >= 0 (0 = 5 x num_episodes), got {self.max_attempts}")
+
+    @property
+    def attempt_budget(self) -> int:
+        return self.max_attempts or 5 * self.num_episodes

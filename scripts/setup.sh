@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Everything igen-lerobot needs on a fresh Debian/Ubuntu machine: Debian packages, uv, Python 3.12
+# and the locked environment in .venv (all workspace packages: core, sim, hardware).
+# Safe to re-run: it only does what is missing.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+# libusb: pyrealsense2 and open3d fail to import without it. EGL/Mesa: headless MuJoCo rendering
+# (MUJOCO_GL=egl). ffmpeg: LeRobot's video decoding (torchcodec). xvfb + xdotool: the teleop test
+# drives LeRobot's keyboard teleoperator on a virtual X display.
+DEBIAN_PACKAGES=(libusb-1.0-0 libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 ffmpeg xvfb xdotool)
+
+missing=()
+for pkg in "${DEBIAN_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing Debian packages: ${missing[*]}"
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if ! command -v uv >/dev/null 2>&1; then
+  echo "setup: installing uv"
+  python3 -m pip install --quiet uv || python3 -m pip install --quiet --user uv
+  export PATH="$HOME/.local/bin:$PATH"
+  hash -r
+fi
+
+# uv cannot download interpreters here: use the machine's Python 3.12 (pyenv or system).
+find_python() {
+  local candidates=("${IGEN_PYTHON:-}" python3.12 /usr/local/bin/python3.12 /usr/bin/python3.12)
+  if command -v pyenv >/dev/null 2>&1; then
+    candidates+=("$(pyenv root)"/versions/3.12*/bin/python3.12)
+  fi
+  candidates+=("$HOME"/.pyenv/versions/3.12*/bin/python3.12)
+  for c in "${candidates[@]}"; do
+    [ -n "$c" ] || continue
+    if "$c" -c 'import sys; assert sys.version_info[:2] == (3, 12)' >/dev/null 2>&1; then
+      "$c" -c 'import sys; print(sys.executable)'
+      return 0
+    fi
+  done
+  return 1
+}
+python=$(find_python) || { echo "setup: Python 3.12 not found; install it or set IGEN_PYTHON=/path/to/python3.12" >&2; exit 1; }
+
+export UV_PYTHON_DOWNLOADS=never
+uv sync --locked --all-packages --python "$python" --quiet
+echo "setup: environment ready in .venv ($("$python" --version), $(uv --version))"

@@ -1,0 +1,84 @@
+"""Pose math as properties (tolerance: 1e-9 on positions/rotations, float64)."""
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from igen_lerobot.geometry import (
+    interpolate_poses,
+    make_pose,
+    pos_quat_to_pose,
+    pose_inv,
+    pose_to_pos_quat,
+    quat_wxyz_to_xyzw,
+    quat_xyzw_to_wxyz,
+    rotation_angle,
+    transform_segment,
+)
+
+seeds = st.integers(0, 2**32 - 1)
+
+
+def random_pose(rng: np.random.Generator) -> np.ndarray:
+    return make_pose(rng.uniform(-1, 1, 3), Rotation.random(random_state=rng).as_matrix())
+
+
+@given(seeds)
+def test_pose_inverse_round_trip(seed):
+    T = random_pose(np.random.default_rng(seed))
+    np.testing.assert_allclose(T @ pose_inv(T), np.eye(4), atol=1e-12)
+    np.testing.assert_allclose(pose_inv(pose_inv(T)), T, atol=1e-12)
+
+
+@given(seeds)
+def test_pos_quat_round_trip_and_scalar_last(seed):
+    rng = np.random.default_rng(seed)
+    T = random_pose(rng)
+    pos, quat = pose_to_pos_quat(T)
+    np.testing.assert_allclose(pos_quat_to_pose(pos, quat), T, atol=1e-12)
+    # scalar-last: identity rotation is (0, 0, 0, 1)
+    np.testing.assert_allclose(pose_to_pos_quat(np.eye(4))[1], [0, 0, 0, 1])
+    np.testing.assert_allclose(quat_xyzw_to_wxyz(quat_wxyz_to_xyzw(quat)), quat)
+    assert quat_wxyz_to_xyzw(np.array([1.0, 0, 0, 0])).tolist() == [0, 0, 0, 1]
+
+
+@given(seeds, st.integers(1, 20))
+def test_transform_segment_preserves_relative_pose_to_object(seed, n):
+    rng = np.random.default_rng(seed)
+    T_obj_src, T_obj_new = random_pose(rng), random_pose(rng)
+    eef_src = np.stack([random_pose(rng) for _ in range(n)])
+    eef_new = transform_segment(eef_src, T_obj_src, T_obj_new)
+    for a, b in zip(eef_src, eef_new, strict=True):
+        np.testing.assert_allclose(pose_inv(T_obj_src) @ a, pose_inv(T_obj_new) @ b, atol=1e-9)
+    # moving into the new frame and back is the identity
+    np.testing.assert_allclose(transform_segment(eef_new, T_obj_new, T_obj_src), eef_src, atol=1e-9)
+
+
+@given(seeds)
+def test_transform_segment_identity_when_object_did_not_move(seed):
+    rng = np.random.default_rng(seed)
+    T_obj = random_pose(rng)
+    eef = np.stack([random_pose(rng) for _ in range(3)])
+    np.testing.assert_allclose(transform_segment(eef, T_obj, T_obj), eef, atol=1e-12)
+
+
+@settings(max_examples=50)
+@given(seeds, st.integers(1, 30))
+def test_interpolation_reaches_target_and_moves_monotonically(seed, steps):
+    rng = np.random.default_rng(seed)
+    start, end = random_pose(rng), random_pose(rng)
+    path = interpolate_poses(start, end, steps)
+    assert path.shape == (steps, 4, 4)
+    np.testing.assert_allclose(path[-1], end, atol=1e-9)
+    dist = np.linalg.norm(path[:, :3, 3] - end[:3, 3], axis=1)
+    assert np.all(np.diff(dist) <= 1e-12)
+    angles = [rotation_angle(p[:3, :3], end[:3, :3]) for p in path]
+    assert np.all(np.diff(angles) <= 1e-9)
+
+
+def test_interpolation_needs_a_step():
+    import pytest
+
+    with pytest.raises(ValueError, match="num_steps"):
+        interpolate_poses(np.eye(4), np.eye(4), 0)
