@@ -43,7 +43,8 @@ class CollectConfig:
     max_attempts: int = 0  # attempts before giving up (0: 5 x num_episodes)
     operator: str = "scripted"  # "scripted" (sees true poses) or "teleop" (a person, --teleop.type=...)
     teleop: TeleoperatorConfig | None = None
-    teleop_step: float = 0.01  # [m] end-effector displacement per teleop step
+    teleop_step: float = 0.01  # [m] controller-goal offset per teleop key step
+    teleop_gate: str = "auto"  # "motion" (held keys), "events" (device intervention button), "auto"
     base_policy: str = "scripted"  # the policy the operator corrects in interventions mode
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
 

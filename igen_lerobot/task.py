@@ -141,11 +141,8 @@ class TaskEnv(abc.ABC):
         from igen_lerobot.geometry import pose_to_pos_quat
 
         poses = self.true_object_poses()
-        parts = []
-        for name in self.spec.objects:
-            pos, quat = pose_to_pos_quat(poses[name])
-            parts.extend([pos, quat])
-        return np.concatenate(parts)
+        pos, quat = pose_to_pos_quat(np.stack([poses[name] for name in self.spec.objects]))
+        return np.concatenate([pos, quat], axis=1).reshape(-1)
 
     def close(self) -> None:  # noqa: B027 - optional hook, most envs hold no resources.
         """Release simulator or hardware resources."""

@@ -1,9 +1,16 @@
-"""A person as the operator, through any LeRobot teleoperator that reports interventions.
+"""A person as the operator, through any LeRobot end-effector teleoperator.
 
 LeRobot's end-effector teleoperators (``keyboard_ee``, ``gamepad``) give ``delta_x/y/z`` in
-{-1, 0, 1} steps and a gripper command (0 close, 1 stay, 2 open), and report
-``TeleopEvents.IS_INTERVENTION`` while the person is pressing movement controls. That is the
-human gate: press to take over, release to hand back to the policy.
+{-1, 0, 1} and a gripper command (0 close, 1 stay, 2 open). The human gate is "hold to take
+over, release to hand back":
+
+* ``gate="events"`` uses the device's ``TeleopEvents.IS_INTERVENTION`` (the gamepad's
+  intervention button: the person may hold still while in control);
+* ``gate="motion"`` counts the person as in control while any motion or gripper key is held.
+  LeRobot's keyboard reports its intervention event only on the step a key-press event arrives
+  (``get_teleop_events`` clears the key state), so a held key would flicker; we therefore never
+  call it for keyboards and read the held keys through ``get_action`` instead.
+* ``gate="auto"`` picks ``motion`` for keyboards and ``events`` otherwise.
 """
 
 from __future__ import annotations
@@ -20,19 +27,25 @@ from igen_lerobot.task import TaskEnv
 logger = logging.getLogger(__name__)
 
 GRIPPER_CLOSE, GRIPPER_STAY, GRIPPER_OPEN = 0, 1, 2
+GATES = ("auto", "motion", "events")
 
 
 class TeleopOperator(Operator):
-    """Wraps a connected-on-demand LeRobot ``Teleoperator``; deltas are scaled to ``step_m`` [m]."""
+    """Wraps a LeRobot ``Teleoperator``; each delta unit moves the end-effector goal ``step_m`` [m]."""
 
-    def __init__(self, teleop: Any, step_m: float = 0.01) -> None:
+    def __init__(self, teleop: Any, step_m: float = 0.01, gate: str = "auto") -> None:
         if step_m <= 0:
             raise ConfigError(f"teleop_step must be > 0 [m per step], got {step_m}")
+        if gate not in GATES:
+            raise ConfigError(f"teleop_gate must be one of {GATES}, got {gate!r}")
         self.teleop = teleop
         self.step_m = float(step_m)
+        if gate == "auto":
+            gate = "motion" if "keyboard" in type(teleop).__name__.lower() else "events"
+        self.gate = gate
         self._gripper_closed = False
         self._last: dict[str, float] | None = None
-        self.terminate_requested = False
+        self._terminate = False
 
     def connect(self) -> None:
         if not self.teleop.is_connected:
@@ -41,22 +54,22 @@ class TeleopOperator(Operator):
     def reset(self, env: TaskEnv) -> None:
         self._gripper_closed = env.gripper_width() < 0.07
         self._last = None
-        self.terminate_requested = False
+        self._terminate = False
 
-    def _poll(self) -> dict[str, Any]:
-        # Order matters for LeRobot's keyboard teleop: get_action drains the key queue that
-        # get_teleop_events then reads (and clears).
+    def _poll(self) -> bool:
+        """Read the device once per step; returns whether the person is in control."""
+        self._last = dict(self.teleop.get_action())
+        if self.gate == "motion":
+            moving = any(float(self._last.get(k, 0.0)) != 0.0 for k in ("delta_x", "delta_y", "delta_z"))
+            return moving or int(round(float(self._last.get("gripper", GRIPPER_STAY)))) != GRIPPER_STAY
         from lerobot.teleoperators.utils import TeleopEvents
 
-        self._last = dict(self.teleop.get_action())
         events = self.teleop.get_teleop_events()
-        self.terminate_requested = bool(events.get(TeleopEvents.TERMINATE_EPISODE, False))
-        return events
+        self._terminate = bool(events.get(TeleopEvents.TERMINATE_EPISODE, False))
+        return bool(events.get(TeleopEvents.IS_INTERVENTION, False))
 
     def wants_control(self, env: TaskEnv, in_control: bool) -> bool:
-        from lerobot.teleoperators.utils import TeleopEvents
-
-        return bool(self._poll().get(TeleopEvents.IS_INTERVENTION, False))
+        return self._poll()
 
     def act(self, env: TaskEnv) -> np.ndarray:
         if self._last is None:
@@ -74,7 +87,7 @@ class TeleopOperator(Operator):
         return env.action_towards(target, self._gripper_closed)
 
     def ends_episode(self) -> bool:
-        return self.terminate_requested
+        return self._terminate
 
     def close(self) -> None:
         if self.teleop.is_connected:

@@ -28,6 +28,7 @@ from igen_lerobot.config_collect import CollectConfig
 from igen_lerobot.corruption import NoNoise
 from igen_lerobot.dataset.writer import DatasetBuilder
 from igen_lerobot.env_config import TaskEnvConfig
+from igen_lerobot.scripts.cli import run_cli
 
 logger = logging.getLogger(__name__)
 
@@ -40,7 +41,7 @@ def make_operator(cfg: CollectConfig, env_cfg: TaskEnvConfig) -> Operator:
 
     from igen_lerobot.teleop import TeleopOperator
 
-    operator = TeleopOperator(make_teleoperator_from_config(cfg.teleop), step_m=cfg.teleop_step)
+    operator = TeleopOperator(make_teleoperator_from_config(cfg.teleop), step_m=cfg.teleop_step, gate=cfg.teleop_gate)
     operator.connect()
     return operator
 
@@ -114,13 +115,7 @@ def collect(cfg: CollectConfig) -> None:
 
 def main() -> None:
     """Console entry point ``igen-collect``."""
-    from lerobot.configs import parser
-    from lerobot.utils.import_utils import register_third_party_plugins
-    from lerobot.utils.utils import init_logging
-
-    init_logging()
-    register_third_party_plugins()
-    parser.wrap()(collect)()
+    run_cli(collect, "igen-collect")
 
 
 if __name__ == "__main__":

@@ -6,7 +6,14 @@ our env configs (``--env.type=block_grasp``) and their gymnasium ids. It imports
 nor robosuite: those load when an env is built.
 """
 
+import os
+
 import gymnasium as gym
+
+# Headless machines (and lerobot-eval's video rendering on them) need MuJoCo's EGL backend; it
+# must be chosen before MuJoCo is first imported. An explicit MUJOCO_GL always wins.
+if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
+    os.environ["MUJOCO_GL"] = "egl"
 
 from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
 

@@ -23,6 +23,15 @@ DEFAULT_GAINS = OscGains()
 
 
 @numba.njit(cache=True)
+def _any_pair(pairs, mask_a, mask_b):  # pragma: no cover - compiled
+    for i in range(pairs.shape[0]):
+        g1, g2 = pairs[i, 0], pairs[i, 1]
+        if (mask_a[g1] and mask_b[g2]) or (mask_a[g2] and mask_b[g1]):
+            return True
+    return False
+
+
+@numba.njit(cache=True)
 def _pair_mask(pairs, mask_a, mask_b):  # pragma: no cover - compiled
     out = np.zeros(pairs.shape[0], dtype=np.bool_)
     for i in range(pairs.shape[0]):
@@ -175,9 +184,10 @@ class PandaArm:
 
     def touching(self, obj_mask: np.ndarray) -> bool:
         """Whether the gripper is in contact with any geom in ``obj_mask`` now."""
-        if self.data.ncon == 0:
+        ncon = self.data.ncon
+        if ncon == 0:
             return False
-        return bool(self._contact_mask(obj_mask).any())
+        return _any_pair(self.data.contact.geom[:ncon], self.gripper_geom_mask, obj_mask)
 
     def contact_points(self, obj_mask: np.ndarray) -> np.ndarray:
         """World positions (k, 3) of the gripper's current contacts with geoms in ``obj_mask``."""

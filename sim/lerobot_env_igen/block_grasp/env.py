@@ -23,7 +23,7 @@ import numpy as np
 
 from igen_lerobot.corruption import PoseNoise, Reveal
 from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.geometry import make_pose, pose_to_pos_quat
+from igen_lerobot.geometry import make_pose
 from igen_lerobot.task import StepInfo, TaskEnv
 from lerobot_env_igen.block_grasp.spec import CUBE_HALF, LIFT_SUCCESS, SPEC, paper_corruption
 from lerobot_env_igen.panda import PandaArm
@@ -79,6 +79,8 @@ class BlockGraspEnv(TaskEnv):
         self._revealed_pos: np.ndarray | None = None
         self._steps = 0
         self._renderer: mujoco.Renderer | None = None
+        self._render_option = mujoco.MjvOption()
+        self._render_option.sitegroup[:] = 0  # hide robosuite's helper sites (grip axis, frames)
 
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int, corruption: np.ndarray | None = None) -> dict[str, np.ndarray]:
@@ -129,10 +131,9 @@ class BlockGraspEnv(TaskEnv):
         state[3:7] = self.arm.eef_quat_xyzw()
         state[7] = self.arm.gripper_width()
         env_state = np.empty(9, dtype=np.float32)
-        believed = self.believed_object_poses()["cube"]
-        pos, quat = pose_to_pos_quat(believed)
-        env_state[:3] = pos
-        env_state[3:7] = quat
+        env_state[:3] = self._believed_cube_pos()
+        quat_wxyz = self.data.xquat[self._cube_body]  # the belief only errs in position
+        env_state[3:7] = (quat_wxyz[1], quat_wxyz[2], quat_wxyz[3], quat_wxyz[0])
         env_state[7] = float(self._contact_now)
         env_state[8] = float(self._revealed)
         return {"observation.state": state, "observation.environment_state": env_state}
@@ -146,16 +147,17 @@ class BlockGraspEnv(TaskEnv):
     def true_object_poses(self) -> dict[str, np.ndarray]:
         return {"cube": self._true_cube_pose()}
 
-    def believed_object_poses(self) -> dict[str, np.ndarray]:
-        true = self._true_cube_pose()
+    def _believed_cube_pos(self) -> np.ndarray:
+        true_pos = self.data.xpos[self._cube_body]
         if not self._revealed or self.reveal_mode is Reveal.NONE:
-            believed = true.copy()
-            # Before contact the robot holds the corrupted estimate of where the cube was placed.
-            believed[:3, 3] = true[:3, 3] + self._offset
-            return {"cube": believed}
+            # Before contact the robot's estimate is off by this episode's error.
+            return true_pos + self._offset
         if self.reveal_mode is Reveal.FULL or self._revealed_pos is None:
-            return {"cube": true}
-        return {"cube": make_pose(self._revealed_pos, true[:3, :3])}
+            return true_pos.copy()
+        return self._revealed_pos.copy()
+
+    def believed_object_poses(self) -> dict[str, np.ndarray]:
+        return {"cube": make_pose(self._believed_cube_pos(), self._true_cube_pose()[:3, :3])}
 
     def eef_pose(self) -> np.ndarray:
         return self.arm.eef_pose()
@@ -217,8 +219,14 @@ class BlockGraspEnv(TaskEnv):
     def render(self, camera: str = "frontview", width: int = 256, height: int = 256) -> np.ndarray:
         """RGB image (H, W, 3) uint8 from one of the scene's cameras (needs MUJOCO_GL=egl headless)."""
         if self._renderer is None or (self._renderer.width, self._renderer.height) != (width, height):
-            self._renderer = mujoco.Renderer(self.model, height=height, width=width)
-        self._renderer.update_scene(self.data, camera=camera)
+            try:
+                self._renderer = mujoco.Renderer(self.model, height=height, width=width)
+            except mujoco.FatalError as err:
+                raise RuntimeError(
+                    "MuJoCo could not create an OpenGL context for rendering. On a headless machine set "
+                    "MUJOCO_GL=egl before starting Python (and install libegl1/libgl1-mesa-dri: scripts/setup.sh)."
+                ) from err
+        self._renderer.update_scene(self.data, camera=camera, scene_option=self._render_option)
         return self._renderer.render()
 
     def close(self) -> None:

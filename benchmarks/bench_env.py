@@ -1,0 +1,122 @@
+"""Block Grasp speed on one core: control steps/s vs the raw physics limit, reset time.
+
+Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_env.py [--steps 3000] [--repeats 3] [--robosuite]
+
+Pinned to CPU 0 with single-threaded BLAS, so the number is per core; each figure is the median
+of ``--repeats`` runs (this VM's speed drifts by +-20% between runs). ``--robosuite`` also times
+robosuite's stock Lift task with its Panda OSC controller for comparison.
+"""
+
+import argparse
+import json
+import os
+import platform
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def time_env(steps: int) -> dict:
+    from igen_lerobot.corruption import NoNoise
+    from lerobot_env_igen.block_grasp.env import BlockGraspEnv
+    from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator, ScriptedGraspPolicy
+
+    t0 = time.perf_counter()
+    env = BlockGraspEnv()
+    build_s = time.perf_counter() - t0
+    env.reset(0)
+    env.step(np.zeros(4))  # compile the numba kernels outside the timed loops
+
+    resets = []
+    for seed in range(50):
+        t0 = time.perf_counter()
+        env.reset(seed)
+        resets.append(time.perf_counter() - t0)
+
+    # env.step + observe, driven by the scripted base policy (what generation runs)
+    policy = ScriptedGraspPolicy()
+    done, seed = 0, 0
+    t0 = time.perf_counter()
+    while done < steps:
+        obs = env.reset(seed)
+        for _ in range(200):
+            info = env.step(policy.act(obs))
+            obs = env.observe()
+            done += 1
+            if info.success or done >= steps:
+                break
+        seed += 1
+    loop_s = time.perf_counter() - t0 - 0.0
+
+    # raw physics of the same model and state: 25 substeps per control step, no controller
+    model, data = env.model, env.data
+    env.reset(0)
+    n_raw = steps * env.arm.substeps // 5
+    t0 = time.perf_counter()
+    for _ in range(n_raw):
+        mujoco.mj_step(model, data)
+    raw_s = time.perf_counter() - t0
+    raw_ctrl_rate = n_raw / raw_s / env.arm.substeps
+
+    # scripted operator success on uncorrupted episodes (unchanged by the fast path)
+    clean = BlockGraspEnv(corruption=NoNoise())
+    operator, ok = ScriptedGraspOperator(), 0
+    for s in range(50):
+        clean.reset(10_000 + s)
+        for _ in range(200):
+            if clean.step(operator.act(clean)).success:
+                ok += 1
+                break
+    return {
+        "env_build_s": build_s,
+        "reset_ms_median": 1000 * float(np.median(resets)),
+        "control_steps_per_s": steps / loop_s,
+        "mj_step_per_s": n_raw / raw_s,
+        "physics_limit_control_steps_per_s": raw_ctrl_rate,
+        "ratio_to_physics_limit": (steps / loop_s) / raw_ctrl_rate,
+        "substeps": env.arm.substeps,
+        "scripted_operator_success_50_seeds": ok / 50,
+    }
+
+
+def time_robosuite_lift(steps: int) -> dict:
+    import robosuite as suite
+    from robosuite.controllers import load_composite_controller_config
+
+    env = suite.make("Lift", robots="Panda", controller_configs=load_composite_controller_config(controller="BASIC"),
+                     has_renderer=False, has_offscreen_renderer=False, use_camera_obs=False, control_freq=20,
+                     horizon=100_000)
+    env.reset()
+    action = np.zeros(env.action_dim)
+    for _ in range(50):  # numba warm-up
+        env.step(action)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        env.step(action)
+    return {"robosuite_lift_control_steps_per_s": steps / (time.perf_counter() - t0)}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--steps", type=int, default=3000)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--robosuite", action="store_true")
+    args = parser.parse_args()
+    os.sched_setaffinity(0, {0})
+    runs = [time_env(args.steps) for _ in range(args.repeats)]
+    if args.robosuite:
+        lift = [time_robosuite_lift(min(args.steps, 600)) for _ in range(args.repeats)]
+        runs = [{**r, **lift_run} for r, lift_run in zip(runs, lift, strict=True)]
+    result = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
+              "repeats": args.repeats}
+    result.update({key: float(np.median([r[key] for r in runs])) for key in runs[0]})
+    print(json.dumps(result, indent=2))
+
+
+if __name__ == "__main__":
+    main()
