@@ -1,0 +1,5 @@
+"""igen's real-robot side as a LeRobot robot plugin (``lerobot_robot_*`` is LeRobot's prefix).
+
+LeRobot imports this package on every ``lerobot-*`` command, so it stays light: hardware
+libraries (franky, pyrealsense2, Open3D) load only where a backend is built.
+"""
