@@ -21,12 +21,20 @@ import numpy as np  # noqa: E402
 def synthetic(spec, rng, length):
     from igen_lerobot.episode import Episode, EpisodeKind
 
-    return Episode(task=spec.name, kind=EpisodeKind.INTERVENTION, seed=int(rng.integers(1 << 31)),
-                   corruption=rng.normal(size=3), state=rng.normal(size=(length, len(spec.state_names))),
-                   env_state=rng.normal(size=(length, len(spec.env_state_names))),
-                   action=rng.normal(size=(length, len(spec.action_names))),
-                   is_intervention=np.arange(length) > length // 2, source=(np.arange(length) > length // 2).astype(int),
-                   subtask=np.zeros(length, int), true_object_pose=rng.normal(size=(length, 7)), success=True)
+    return Episode(
+        task=spec.name,
+        kind=EpisodeKind.INTERVENTION,
+        seed=int(rng.integers(1 << 31)),
+        corruption=rng.normal(size=3),
+        state=rng.normal(size=(length, len(spec.state_names))),
+        env_state=rng.normal(size=(length, len(spec.env_state_names))),
+        action=rng.normal(size=(length, len(spec.action_names))),
+        is_intervention=np.arange(length) > length // 2,
+        source=(np.arange(length) > length // 2).astype(int),
+        subtask=np.zeros(length, int),
+        true_object_pose=rng.normal(size=(length, 7)),
+        success=True,
+    )
 
 
 def main() -> None:

@@ -88,9 +88,16 @@ def time_robosuite_lift(steps: int) -> dict:
     import robosuite as suite
     from robosuite.controllers import load_composite_controller_config
 
-    env = suite.make("Lift", robots="Panda", controller_configs=load_composite_controller_config(controller="BASIC"),
-                     has_renderer=False, has_offscreen_renderer=False, use_camera_obs=False, control_freq=20,
-                     horizon=100_000)
+    env = suite.make(
+        "Lift",
+        robots="Panda",
+        controller_configs=load_composite_controller_config(controller="BASIC"),
+        has_renderer=False,
+        has_offscreen_renderer=False,
+        use_camera_obs=False,
+        control_freq=20,
+        horizon=100_000,
+    )
     env.reset()
     action = np.zeros(env.action_dim)
     for _ in range(50):  # numba warm-up
@@ -112,8 +119,10 @@ def main() -> None:
     if args.robosuite:
         lift = [time_robosuite_lift(min(args.steps, 600)) for _ in range(args.repeats)]
         runs = [{**r, **lift_run} for r, lift_run in zip(runs, lift, strict=True)]
-    result = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
-              "repeats": args.repeats}
+    result = {
+        "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
+        "repeats": args.repeats,
+    }
     result.update({key: float(np.median([r[key] for r in runs])) for key in runs[0]})
     print(json.dumps(result, indent=2))
 

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
 from igen_lerobot.agents import Operator, Policy
 from igen_lerobot.episode import Episode, EpisodeKind
-from igen_lerobot.task import OBS_ENV_STATE, OBS_STATE, FrameSource, TaskEnv
+from igen_lerobot.recorder import EpisodeRecorder
+from igen_lerobot.task import FrameSource, TaskEnv
 
 logger = logging.getLogger(__name__)
 
@@ -23,48 +23,6 @@ logger = logging.getLogger(__name__)
 def episode_seed(run_seed: int, attempt: int) -> int:
     """Seed of attempt ``attempt`` of a run: independent streams, reproducible from the run seed."""
     return int(np.random.SeedSequence([run_seed, attempt]).generate_state(1)[0])
-
-
-@dataclass
-class EpisodeRecorder:
-    """Collects frames while an episode runs."""
-
-    env: TaskEnv
-
-    def __post_init__(self) -> None:
-        self.state: list[np.ndarray] = []
-        self.env_state: list[np.ndarray] = []
-        self.action: list[np.ndarray] = []
-        self.flag: list[bool] = []
-        self.source: list[int] = []
-        self.subtask: list[int] = []
-        self.truth: list[np.ndarray] = []
-
-    def record(self, obs: dict[str, np.ndarray], action: np.ndarray, source: FrameSource, flagged: bool) -> None:
-        self.state.append(obs[OBS_STATE])
-        self.env_state.append(obs[OBS_ENV_STATE])
-        self.action.append(np.asarray(action, dtype=np.float32))
-        self.flag.append(flagged)
-        self.source.append(int(source))
-        self.subtask.append(min(self.env.subtask_index(), len(self.env.spec.subtasks) - 1))
-        self.truth.append(self.env.true_object_pose_vector())
-
-    def episode(self, kind: str, seed: int, success: bool, **extra: object) -> Episode:
-        return Episode(
-            task=self.env.spec.name,
-            kind=kind,
-            seed=seed,
-            corruption=self.env.corruption,
-            state=np.asarray(self.state, dtype=np.float32),
-            env_state=np.asarray(self.env_state, dtype=np.float32),
-            action=np.asarray(self.action, dtype=np.float32),
-            is_intervention=np.asarray(self.flag, dtype=bool),
-            source=np.asarray(self.source, dtype=np.int64),
-            subtask=np.asarray(self.subtask, dtype=np.int64),
-            true_object_pose=np.asarray(self.truth, dtype=np.float32),
-            success=success,
-            extra=dict(extra),
-        )
 
 
 class RatePacer:

@@ -38,9 +38,16 @@ class SubtaskSpec:
     object_name: str
 
 
+EEF_STATE_NAMES = ("eef.x", "eef.y", "eef.z", "eef.qx", "eef.qy", "eef.qz", "eef.qw")
+
+
 @dataclass(frozen=True)
 class TaskSpec:
-    """Static description of a task: what datasets, generators and policies must agree on."""
+    """Static description of a task: what datasets, generators and policies must agree on.
+
+    Convention: ``observation.state`` starts with the end-effector pose (``EEF_STATE_NAMES``:
+    position [m] + quaternion xyzw), so recorded episodes can be replayed in any new scene.
+    """
 
     name: str
     instruction: str
@@ -52,6 +59,30 @@ class TaskSpec:
     state_names: tuple[str, ...]
     env_state_names: tuple[str, ...]
     action_names: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if tuple(self.state_names[:7]) != EEF_STATE_NAMES:
+            raise ValueError(f"task {self.name!r}: state_names must start with {EEF_STATE_NAMES}")
+        for sub in self.subtasks:
+            if sub.object_name not in self.objects:
+                raise ValueError(
+                    f"task {self.name!r}: subtask {sub.name!r} refers to unknown object {sub.object_name!r}"
+                )
+
+    def eef_poses(self, state: np.ndarray) -> np.ndarray:
+        """``T_world_eef`` (N, 4, 4) from ``observation.state`` rows (N, S)."""
+        from igen_lerobot.geometry import pos_quat_to_pose
+
+        state = np.asarray(state, dtype=float)
+        return pos_quat_to_pose(state[..., :3], state[..., 3:7])
+
+    def object_poses(self, true_object_pose: np.ndarray, name: str) -> np.ndarray:
+        """``T_world_obj`` (N, 4, 4) of object ``name`` from ``complementary_info.true_object_pose`` rows."""
+        from igen_lerobot.geometry import pos_quat_to_pose
+
+        k = self.objects.index(name)
+        rows = np.asarray(true_object_pose, dtype=float)[..., 7 * k : 7 * k + 7]
+        return pos_quat_to_pose(rows[..., :3], rows[..., 3:7])
 
     @property
     def object_pose_names(self) -> tuple[str, ...]:
@@ -130,6 +161,14 @@ class TaskEnv(abc.ABC):
     @abc.abstractmethod
     def gripper_command(self, action: np.ndarray) -> bool:
         """Whether ``action`` commands the gripper closed."""
+
+    @abc.abstractmethod
+    def target_pose_from_action(self, T_world_eef: np.ndarray, action: np.ndarray) -> np.ndarray:
+        """The end-effector goal ``action`` sets when taken at ``T_world_eef``.
+
+        The inverse of :meth:`action_towards`: what the generator transforms when it moves a
+        recorded segment into a new scene.
+        """
 
     def action_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Per-dimension action limits the env clips to (unbounded unless a task says otherwise)."""

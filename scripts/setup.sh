@@ -48,5 +48,5 @@ find_python() {
 python=$(find_python) || { echo "setup: Python 3.12 not found; install it or set IGEN_PYTHON=/path/to/python3.12" >&2; exit 1; }
 
 export UV_PYTHON_DOWNLOADS=never
-uv sync --locked --all-packages --python "$python" --quiet
+uv sync --locked --all-packages --all-extras --python "$python" --quiet
 echo "setup: environment ready in .venv ($("$python" --version), $(uv --version))"

@@ -18,3 +18,45 @@ def block_grasp_env(block_grasp_config):
     env = block_grasp_config.make_task_env()
     yield env
     env.close()
+
+
+def _record_sources(tmp_path_factory, config, mode, n, seed):
+    import dataclasses
+
+    from igen_lerobot.collect import episode_seed, record_demo, record_intervention
+    from igen_lerobot.corruption import NoNoise
+    from igen_lerobot.dataset.writer import DatasetBuilder
+
+    if mode == "demos":
+        config = dataclasses.replace(config, corruption=NoNoise())
+    env = config.make_task_env()
+    operator, policy = config.make_scripted_operator(), config.make_scripted_policy()
+    root = tmp_path_factory.mktemp("sources") / f"block_grasp_{mode}"
+    builder = DatasetBuilder(root, f"local/{root.name}", env.spec)
+    kept, attempt = 0, 0
+    while kept < n:
+        s = episode_seed(seed, attempt)
+        ep = (
+            record_demo(env, operator, s, 200)
+            if mode == "demos"
+            else record_intervention(env, policy, operator, s, 200)
+        )
+        if ep.success and (mode == "demos" or ep.is_intervention.any()):
+            builder.spool.keep(attempt, ep)
+            kept += 1
+        attempt += 1
+    builder.finalize(n, metadata={"created_by": "test", "mode": mode})
+    env.close()
+    return root
+
+
+@pytest.fixture(scope="session")
+def source_demos(tmp_path_factory, block_grasp_config):
+    """10 scripted-operator demonstrations, written as an igen dataset."""
+    return _record_sources(tmp_path_factory, block_grasp_config, "demos", 10, seed=100)
+
+
+@pytest.fixture(scope="session")
+def source_interventions(tmp_path_factory, block_grasp_config):
+    """10 human-gated (scripted operator) interventions, written as an igen dataset."""
+    return _record_sources(tmp_path_factory, block_grasp_config, "interventions", 10, seed=200)

@@ -22,8 +22,15 @@ def run(cmd, **kwargs):
 
 
 def collect_cmd(root, n, seed=5, mode="interventions"):
-    return [str(BIN / "igen-collect"), "--env.type=block_grasp", f"--mode={mode}", f"--num_episodes={n}",
-            f"--seed={seed}", "--dataset.repo_id=local/cli", f"--dataset.root={root}"]
+    return [
+        str(BIN / "igen-collect"),
+        "--env.type=block_grasp",
+        f"--mode={mode}",
+        f"--num_episodes={n}",
+        f"--seed={seed}",
+        "--dataset.repo_id=local/cli",
+        f"--dataset.root={root}",
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -38,8 +45,9 @@ def test_collect_resumes_after_kill_to_the_same_dataset(tmp_path, spec):
     assert reference.returncode == 0, reference.stderr[-3000:]
 
     env = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
-    proc = subprocess.Popen(collect_cmd(tmp_path / "resumed", 3), env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        collect_cmd(tmp_path / "resumed", 3), env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     spool = tmp_path / "resumed.partial" / "attempts"
     deadline = time.time() + 300
     while time.time() < deadline and not list(spool.glob("attempt_*.npz")) and proc.poll() is None:
@@ -99,15 +107,36 @@ def test_collect_cli_reports_bad_flags(tmp_path):
 def test_lerobot_train_and_eval_run_on_our_dataset_and_env(tmp_path):
     demos = run(collect_cmd(tmp_path / "demos", 2, mode="demos"))
     assert demos.returncode == 0, demos.stderr[-3000:]
-    train = run([str(BIN / "lerobot-train"), "--policy.type=act", "--dataset.repo_id=local/cli",
-                 f"--dataset.root={tmp_path / 'demos'}", "--steps=2", "--batch_size=2", "--policy.device=cpu",
-                 f"--output_dir={tmp_path / 'train'}", "--policy.push_to_hub=false", "--save_freq=2",
-                 "--num_workers=0", "--wandb.enable=false"])
+    train = run(
+        [
+            str(BIN / "lerobot-train"),
+            "--policy.type=act",
+            "--dataset.repo_id=local/cli",
+            f"--dataset.root={tmp_path / 'demos'}",
+            "--steps=2",
+            "--batch_size=2",
+            "--policy.device=cpu",
+            f"--output_dir={tmp_path / 'train'}",
+            "--policy.push_to_hub=false",
+            "--save_freq=2",
+            "--num_workers=0",
+            "--wandb.enable=false",
+        ]
+    )
     assert train.returncode == 0, train.stderr[-3000:]
     checkpoint = tmp_path / "train/checkpoints/last/pretrained_model"
-    evaluation = run([str(BIN / "lerobot-eval"), f"--policy.path={checkpoint}", "--env.type=block_grasp",
-                      "--env.episode_length=10", "--eval.n_episodes=1", "--eval.batch_size=1",
-                      "--policy.device=cpu", f"--output_dir={tmp_path / 'eval'}"])
+    evaluation = run(
+        [
+            str(BIN / "lerobot-eval"),
+            f"--policy.path={checkpoint}",
+            "--env.type=block_grasp",
+            "--env.episode_length=10",
+            "--eval.n_episodes=1",
+            "--eval.batch_size=1",
+            "--policy.device=cpu",
+            f"--output_dir={tmp_path / 'eval'}",
+        ]
+    )
     assert evaluation.returncode == 0, evaluation.stderr[-3000:]
     import json
 

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from igen_lerobot.exceptions import ConfigError
-from lerobot_robot_igen.safety import SafetyGuard, SafetyLimits, SafetyViolation, Watchdog
+from lerobot_robot_igen.safety import SafetyGuard, SafetyLimits, SafetyViolationError, Watchdog
 
 
 @pytest.mark.parametrize("module", ["pyrealsense2", "open3d", "franky"])
@@ -37,7 +37,7 @@ def test_targets_inside_are_speed_limited_and_outside_refused(current, target):
     guard = SafetyGuard(SafetyLimits())
     current, target = np.array(current), np.array(target)
     if not guard.inside(target):
-        with pytest.raises(SafetyViolation, match="outside the workspace"):
+        with pytest.raises(SafetyViolationError, match="outside the workspace"):
             guard.filter_target(current, target, period=0.05)
         return
     out = guard.filter_target(current, target, period=0.05)

@@ -17,7 +17,7 @@ import numpy as np
 from igen_lerobot.exceptions import ConfigError, IgenError
 
 
-class SafetyViolation(IgenError, RuntimeError):
+class SafetyViolationError(IgenError, RuntimeError):
     """A command would break a safety limit; the robot must stop."""
 
 
@@ -53,12 +53,12 @@ class SafetyGuard:
         return bool(np.all(position >= self.limits.workspace_min) and np.all(position <= self.limits.workspace_max))
 
     def filter_target(self, current: np.ndarray, target: np.ndarray, period: float) -> np.ndarray:
-        """A target reachable within ``period`` [s] at the speed limit, or :class:`SafetyViolation`."""
+        """A target reachable within ``period`` [s] at the speed limit, or :class:`SafetyViolationError`."""
         current, target = np.asarray(current, float), np.asarray(target, float)
         if not np.all(np.isfinite(target)):
-            raise SafetyViolation(f"target {target.tolist()} is not finite")
+            raise SafetyViolationError(f"target {target.tolist()} is not finite")
         if not self.inside(target):
-            raise SafetyViolation(
+            raise SafetyViolationError(
                 f"target {np.round(target, 4).tolist()} m is outside the workspace "
                 f"{self.limits.workspace_min}..{self.limits.workspace_max} m (robot base frame)"
             )

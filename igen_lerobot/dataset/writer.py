@@ -93,8 +93,9 @@ class DatasetBuilder:
 
     def finalize(self, num_episodes: int | None, metadata: dict, fast_write: bool = True) -> BuildSummary:
         """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at ``root``."""
-        import datasets
         from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+        import datasets
 
         datasets.disable_progress_bars()  # one bar per episode otherwise; ours covers the whole write
 

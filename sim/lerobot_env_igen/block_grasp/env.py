@@ -211,6 +211,11 @@ class BlockGraspEnv(TaskEnv):
     def gripper_command(self, action: np.ndarray) -> bool:
         return bool(action[3] > 0.0)
 
+    def target_pose_from_action(self, T_world_eef: np.ndarray, action: np.ndarray) -> np.ndarray:
+        target = np.array(T_world_eef, dtype=float)
+        target[:3, 3] += np.clip(np.asarray(action[:3], dtype=float), -self.max_delta, self.max_delta)
+        return target
+
     def action_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         high = np.array([self.max_delta] * 3 + [1.0])
         return -high, high

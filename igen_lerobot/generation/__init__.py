@@ -1,0 +1,1 @@
+"""Data generation: MimicGen demonstrations and IntervenGen interventions from a few sources."""
