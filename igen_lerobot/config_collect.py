@@ -10,10 +10,10 @@ from lerobot.teleoperators.config import TeleoperatorConfig
 
 from igen_lerobot.env_config import TaskEnvConfig
 from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.policies.source import PolicySourceConfig
 
 MODES = ("demos", "interventions")
 OPERATORS = ("scripted", "teleop")
-BASE_POLICIES = ("scripted",)
 
 
 @dataclass
@@ -45,7 +45,7 @@ class CollectConfig:
     teleop: TeleoperatorConfig | None = None
     teleop_step: float = 0.01  # [m] controller-goal offset per teleop key step
     teleop_gate: str = "auto"  # "motion" (held keys), "events" (device intervention button), "auto"
-    base_policy: str = "scripted"  # the policy the operator corrects in interventions mode
+    policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # the base policy the operator corrects
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
 
     def __post_init__(self) -> None:
@@ -64,8 +64,8 @@ class CollectConfig:
             raise ConfigError(
                 "--operator=teleop needs a device, e.g. --teleop.type=keyboard_ee or --teleop.type=gamepad"
             )
-        if self.base_policy not in BASE_POLICIES:
-            raise ConfigError(f"--base_policy must be one of {BASE_POLICIES}, got {self.base_policy!r}")
+        if self.policy.path and self.mode == "demos":
+            raise ConfigError("--policy.path only applies to --mode=interventions (demos are the operator's alone)")
         if self.num_episodes < 1:
             raise ConfigError(f"--num_episodes must be >= 1, got {self.num_episodes}")
         if self.max_attempts < 0:

@@ -10,9 +10,10 @@ from igen_lerobot.config_collect import DatasetOutputConfig
 from igen_lerobot.env_config import TaskEnvConfig, task_config_class
 from igen_lerobot.exceptions import ConfigError
 from igen_lerobot.generation.intervengen import IntervenGenConfig
-from igen_lerobot.generation.job import GenerationMode, PolicySourceConfig
+from igen_lerobot.generation.job import GenerationMode
 from igen_lerobot.generation.mimicgen import MimicGenConfig
 from igen_lerobot.generation.runner import BACKENDS
+from igen_lerobot.policies.source import PolicySourceConfig
 
 
 @dataclass

@@ -12,6 +12,7 @@ from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.intervengen import IntervenGenConfig, MistakeSource, generate_intervention
 from igen_lerobot.generation.mimicgen import MimicGenConfig, generate_demo
 from igen_lerobot.generation.sources import SourceLibrary
+from igen_lerobot.policies.source import PolicySourceConfig, make_base_policy
 
 
 class GenerationMode(enum.StrEnum):
@@ -20,14 +21,6 @@ class GenerationMode(enum.StrEnum):
     MIMICGEN = "mimicgen"  # full demonstrations from source demonstrations
     IGEN = "igen"  # interventions: policy mistakes + replayed recoveries
     IGEN_NO_POLICY = "igen_no_policy"  # ablation: replayed mistakes + replayed recoveries
-
-
-@dataclass
-class PolicySourceConfig:
-    """The base policy whose mistakes IntervenGen corrects."""
-
-    path: str | None = None  # a LeRobot checkpoint's pretrained_model/ folder; None: the task's scripted base policy
-    device: str = "cpu"
 
 
 @dataclass
@@ -64,12 +57,7 @@ class AttemptRunner:
         self.env = job.env_config.make_task_env()
         self.policy = None
         if job.mode is GenerationMode.IGEN:
-            if job.policy.path:
-                from igen_lerobot.policies.lerobot_checkpoint import LeRobotCheckpointPolicy
-
-                self.policy = LeRobotCheckpointPolicy(job.policy.path, self.env.spec, device=job.policy.device)
-            else:
-                self.policy = job.env_config.make_scripted_policy()
+            self.policy = make_base_policy(job.policy, job.env_config)
 
     def __call__(self, attempt: int) -> Attempt:
         seed = episode_seed(self.job.run_seed, attempt)

@@ -28,6 +28,7 @@ from igen_lerobot.config_collect import CollectConfig
 from igen_lerobot.corruption import NoNoise
 from igen_lerobot.dataset.writer import DatasetBuilder
 from igen_lerobot.env_config import TaskEnvConfig
+from igen_lerobot.policies.source import make_base_policy
 from igen_lerobot.scripts.cli import run_cli
 
 logger = logging.getLogger(__name__)
@@ -61,7 +62,7 @@ def collect(cfg: CollectConfig) -> None:
         logger.info("resuming %s: %d episodes kept from %d attempts", builder.work_dir, kept, len(done))
     env = env_cfg.make_task_env()
     operator = make_operator(cfg, env_cfg)
-    policy = env_cfg.make_scripted_policy()
+    policy = make_base_policy(cfg.policy, env_cfg) if cfg.mode == "interventions" else None
     rate = spec.fps if cfg.operator == "teleop" else None
     try:
         attempt = 0
@@ -106,6 +107,7 @@ def collect(cfg: CollectConfig) -> None:
             "mode": cfg.mode,
             "seed": cfg.seed,
             "operator": cfg.operator,
+            "policy": cfg.policy.describe() if cfg.mode == "interventions" else None,
             "env": draccus.encode(env_cfg),
             "rejections": spool.rejection_reasons(),
         },

@@ -69,8 +69,8 @@ class GraspRule:
 class ScriptedGraspPolicy:
     """Base policy: the grasp rule on the observed cube pose (trusts its perception)."""
 
-    def __init__(self, rule: GraspRule = GraspRule()) -> None:
-        self.rule = rule
+    def __init__(self, rule: GraspRule | None = None) -> None:
+        self.rule = rule or GraspRule()
 
     def reset(self) -> None:
         """Stateless."""
@@ -88,11 +88,17 @@ class ScriptedGraspOperator(Operator):
     a gripper-cube contact while the gripper is off the cube's grasp axis, the gripper closing
     off that axis, or the fingertips below the cube's top while off it (a miss without contact).
     "Off the axis" means more than ``mistake_xy`` [m] from the cube centre in the table plane.
+    A policy that has not grasped after ``patience_steps`` (it wanders) is taken over too.
     """
 
-    def __init__(self, rule: GraspRule = GraspRule(), mistake_xy: float = 0.010) -> None:
-        self.rule = rule
+    def __init__(self, rule: GraspRule | None = None, mistake_xy: float = 0.010, patience_steps: int = 100) -> None:
+        self.rule = rule or GraspRule()
         self.mistake_xy = mistake_xy
+        self.patience_steps = patience_steps
+        self._watched = 0
+
+    def reset(self, env: TaskEnv) -> None:
+        self._watched = 0
 
     def judges_mistake(self, env: BlockGraspEnv) -> bool:
         eef = env.eef_pose()[:3, 3]
@@ -103,7 +109,8 @@ class ScriptedGraspOperator(Operator):
         return off_axis and (env.contact or closing or below_top)
 
     def wants_control(self, env: TaskEnv, in_control: bool) -> bool:
-        return in_control or self.judges_mistake(env)
+        self._watched += 1
+        return in_control or self.judges_mistake(env) or self._watched > self.patience_steps
 
     def act(self, env: TaskEnv) -> np.ndarray:
         eef = env.eef_pose()[:3, 3]
