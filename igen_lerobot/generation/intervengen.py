@@ -45,6 +45,8 @@ class IntervenGenConfig:
     selection: Selection = Selection.RANDOM  # the paper picks a random source recovery
     top_k: int = 3
     mistake_budget: int = 120  # policy steps without a detected mistake before forcing a recovery
+    # An attempt may run for the task's episode length plus this budget, so a policy that used its
+    # whole budget still leaves a full episode's time for the recovery.
     max_recoveries: int = 3  # mistake/recovery alternations allowed in one episode
     replay: ReplayConfig = field(default_factory=ReplayConfig)
 

@@ -23,13 +23,20 @@ from igen_lerobot.task import FrameSource, StepInfo, TaskEnv
 class ReplayConfig:
     """How transformed segments are executed."""
 
-    interpolation_steps: int = 5  # control steps bridging the current pose and the segment's start
+    interpolation_steps: int = 5  # minimum control steps bridging the current pose and the segment's start
+    interpolation_speed: float = 0.015  # [m per step] longer bridges get more steps, so the arm can follow
     target_noise: float = 0.0  # [m] std of Gaussian noise on replayed goal positions (MimicGen's action noise)
     hold_steps: int = 10  # extra steps holding the last goal while the task is not done yet
 
     def __post_init__(self) -> None:
         if self.interpolation_steps < 1:
             raise ConfigError(f"replay.interpolation_steps must be >= 1, got {self.interpolation_steps}")
+        if self.interpolation_speed <= 0:
+            raise ConfigError(f"replay.interpolation_speed must be > 0 [m per step], got {self.interpolation_speed}")
+
+    def bridge_steps(self, distance: float) -> int:
+        """Steps for a bridge of ``distance`` [m]: at least ``interpolation_steps``."""
+        return max(self.interpolation_steps, int(np.ceil(distance / self.interpolation_speed)))
         if self.target_noise < 0:
             raise ConfigError(f"replay.target_noise must be >= 0 [m], got {self.target_noise}")
         if self.hold_steps < 0:
@@ -65,7 +72,9 @@ def replay_segment(
     """
     T_world_obj = env.true_object_poses()[segment.object_name]
     transformed = transform_segment(segment.targets, segment.T_world_obj, T_world_obj)
-    bridge = interpolate_poses(env.eef_pose(), transformed[0], cfg.interpolation_steps)
+    T_world_eef = env.eef_pose()
+    distance = float(np.linalg.norm(transformed[0][:3, 3] - T_world_eef[:3, 3]))
+    bridge = interpolate_poses(T_world_eef, transformed[0], cfg.bridge_steps(distance))
     hold = np.repeat(transformed[-1:], cfg.hold_steps, axis=0)
     goals = np.concatenate([bridge, transformed, hold])
     gripper = np.concatenate(

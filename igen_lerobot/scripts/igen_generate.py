@@ -62,12 +62,14 @@ def generate(cfg: GenerateConfig) -> None:
 
     repo_id, root = cfg.dataset.resolve(f"{spec.name}_{mode.value}")
     builder = DatasetBuilder(root, repo_id, spec, overwrite=cfg.dataset.overwrite)
+    # IntervenGen attempts get the policy's mistake budget on top of an episode (see IntervenGenConfig)
+    max_steps = env_cfg.episode_length + (0 if mode is GenerationMode.MIMICGEN else cfg.igen.mistake_budget)
     job = GenerationJob(
         mode=mode,
         env_config=env_cfg,
         library=library,
         run_seed=cfg.seed,
-        max_steps=env_cfg.episode_length,
+        max_steps=max_steps,
         policy=cfg.policy,
         mimicgen=cfg.mimicgen,
         igen=cfg.igen,
