@@ -33,8 +33,8 @@ def test_two_iterations_grow_the_dataset_and_resume_without_redoing(source_demos
     produced = json.loads(first.stdout[first.stdout.index("{") :])
     base = len(load_episodes(source_demos, SPEC))
     sizes = []
-    for i, it in enumerate(produced["iterations"]):
-        # the policy of iteration i was trained by lerobot-train on D_i
+    for it in produced["iterations"]:
+        # the policy of each iteration was trained by lerobot-train on that D
         assert (Path(it["policy"]) / "model.safetensors").exists()
         sources = load_episodes(it["interventions"], SPEC)
         assert len(sources) == 2 and all(e.is_intervention.any() for e in sources)
