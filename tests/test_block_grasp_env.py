@@ -141,3 +141,13 @@ def test_action_offsets_the_controller_goal_from_the_current_pose(block_grasp_en
     assert slow[1] > 0.03 and abs(slow[0]) < 0.005 and abs(slow[2]) < 0.005  # along +y only
     assert 1.7 < fast[1] / slow[1] < 2.3  # speed proportional to the offset (critically damped OSC)
     np.testing.assert_allclose(env.eef_pose()[:3, :3], [[0, 1, 0], [1, 0, 0], [0, 0, -1]], atol=0.02)
+
+
+def test_fast_true_pose_vector_matches_the_generic_conversion(block_grasp_env):
+    from igen_lerobot.task import TaskEnv
+
+    env = block_grasp_env
+    env.reset(4)
+    for _ in range(3):
+        env.step(np.array([0.01, 0.0, -0.01, 1.0]))
+    np.testing.assert_allclose(env.true_object_pose_vector(), TaskEnv.true_object_pose_vector(env), atol=1e-9)

@@ -108,15 +108,17 @@ def test_intervengen_flags_exactly_the_replayed_recovery(env, intervention_libra
         assert not np.allclose(ep.corruption, 0)
         # every stored frame is the recovery: bridge frames, then the transformed source segment
         assert ep.is_intervention.all()
-        bridge = cfg.replay.interpolation_steps
-        np.testing.assert_array_equal(ep.source[:bridge], FrameSource.INTERPOLATION)
-        np.testing.assert_array_equal(ep.source[bridge:], FrameSource.GENERATED)
         # the goals the stored actions set are the source recovery's goals, moved to this cube
         (recovery_episode,) = attempt.details["recoveries"]
         segment = next(s for s in intervention_library.select(SegmentRole.RECOVERY, 0) if s.episode == recovery_episode)
         T_obj_now = env.spec.object_poses(ep.true_object_pose[0], "cube")
         expected = transform_segment(segment.targets, segment.T_world_obj, T_obj_now)[:, :3, 3]
         eef = env.spec.eef_poses(ep.state)
+        # the bridge: at least interpolation_steps, longer when the segment starts farther away
+        bridge = cfg.replay.bridge_steps(float(np.linalg.norm(expected[0] - eef[0][:3, 3])))
+        assert bridge >= cfg.replay.interpolation_steps
+        np.testing.assert_array_equal(ep.source[:bridge], FrameSource.INTERPOLATION)
+        np.testing.assert_array_equal(ep.source[bridge:], FrameSource.GENERATED)
         implied = np.stack([env.target_pose_from_action(T, a)[:3, 3] for T, a in zip(eef, ep.action, strict=True)])
         replayed = implied[bridge : bridge + len(expected)]
         unclipped = np.all(np.abs(ep.action[bridge : bridge + len(expected), :3]) < env.max_delta - 1e-6, axis=1)
@@ -147,3 +149,29 @@ def test_attempts_are_reproducible_from_their_seed(env, intervention_library, bl
     assert a.kept == b.kept and a.details == b.details
     if a.kept:
         np.testing.assert_array_equal(a.episode.action, b.episode.action)
+
+
+def test_policy_takes_over_again_after_an_unfinished_recovery(env, intervention_library, block_grasp_config):
+    """Mistake -> recovery -> policy: a recovery cut short hands back to the policy, whose own
+    grasp (the pose is known by then) is not taken for a new mistake."""
+    short = dataclasses.replace(
+        intervention_library,
+        segments=[
+            dataclasses.replace(s, targets=s.targets[:12], eef=s.eef[:12], gripper_closed=s.gripper_closed[:12])
+            if s.role is SegmentRole.RECOVERY
+            else s
+            for s in intervention_library.segments
+        ],
+    )
+    cfg = IntervenGenConfig(replay=dataclasses.replace(IntervenGenConfig().replay, hold_steps=0))
+    policy = block_grasp_config.make_scripted_policy()
+    kept = [
+        a for a in (generate_intervention(env, policy, short, cfg, seed, 320) for seed in range(1100, 1106)) if a.kept
+    ]
+    assert kept
+    for attempt in kept:
+        ep = attempt.episode
+        assert len(attempt.details["recoveries"]) == 1
+        flagged = np.flatnonzero(ep.is_intervention)
+        assert flagged[0] == 0 and np.all(np.diff(flagged) == 1)  # one recovery run, first
+        assert ep.source[-1] == FrameSource.POLICY and not ep.is_intervention[-1]  # the policy finished

@@ -57,8 +57,15 @@ class IntervenGenConfig:
             raise ConfigError(f"igen.max_recoveries must be >= 1, got {self.max_recoveries}")
 
 
-def _run_policy_until_mistake(env: TaskEnv, policy: Policy, recorder: EpisodeRecorder, obs: dict, budget: int):
-    """Policy steps until contact (mistake), success, a finished subtask, or the budget."""
+def _run_policy_until_mistake(
+    env: TaskEnv, policy: Policy, recorder: EpisodeRecorder, obs: dict, budget: int, revealed: bool
+):
+    """Policy steps until a mistake, success, a finished subtask, or the budget.
+
+    A mistake is the contact that reveals the pose error (the robot touches the object where it
+    did not believe it was). Contacts once the pose is known are the policy manipulating the
+    object, not mistakes: after a recovery the policy may grasp without triggering another one.
+    """
     subtask = env.subtask_index()
     for step in range(budget):
         action = policy.act(obs)
@@ -66,12 +73,13 @@ def _run_policy_until_mistake(env: TaskEnv, policy: Policy, recorder: EpisodeRec
         info = env.step(action)
         obs = env.observe()
         if info.success:
-            return obs, "success", step + 1
-        if info.contact:
-            return obs, "mistake", step + 1
+            return obs, "success", step + 1, info.revealed
+        if info.contact and not revealed:
+            return obs, "mistake", step + 1, info.revealed
+        revealed = info.revealed
         if env.subtask_index() != subtask:
-            return obs, "subtask_done", step + 1
-    return obs, "budget", budget
+            return obs, "subtask_done", step + 1, revealed
+    return obs, "budget", budget, revealed
 
 
 def generate_intervention(
@@ -102,7 +110,7 @@ def generate_intervention(
         policy.reset()
     first_mistake: int | None = None
     recoveries: list[int] = []
-    success, steps = False, 0
+    success, steps, revealed = False, 0, False
     while steps < max_steps and not success:
         subtask = min(env.subtask_index(), len(env.spec.subtasks) - 1)
         if replayed_mistake is not None:
@@ -119,14 +127,15 @@ def generate_intervention(
             )
             obs, steps = outcome.obs, steps + outcome.steps
             success = bool(outcome.info and outcome.info.success)
+            revealed = bool(outcome.info and outcome.info.revealed)
             why = "success" if success else "mistake"
             replayed_mistake = None  # one replayed mistake, then recoveries (as the source had)
         else:
             if policy is None:  # ablation after its replayed mistake: another recovery, no policy
                 why = "budget"
             else:
-                obs, why, n = _run_policy_until_mistake(
-                    env, policy, recorder, obs, min(cfg.mistake_budget, max_steps - steps)
+                obs, why, n, revealed = _run_policy_until_mistake(
+                    env, policy, recorder, obs, min(cfg.mistake_budget, max_steps - steps), revealed
                 )
                 steps += n
                 success = why == "success"
@@ -147,6 +156,7 @@ def generate_intervention(
         )
         obs, steps = outcome.obs, steps + outcome.steps
         success = bool(outcome.info and outcome.info.success)
+        revealed = revealed or bool(outcome.info and outcome.info.revealed)
         if policy is not None:
             policy.reset()
     details = {"recoveries": recoveries, "mistake_step": first_mistake}

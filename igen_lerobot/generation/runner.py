@@ -341,7 +341,8 @@ def run_generation(
                         spool.keep(attempt, result.episode)
                     stats.kept += 1
                     stats.frames += result.length
-                    bar.update(1)
+                    if bar.n < num_episodes:  # attempts already in flight may keep a few extra
+                        bar.update(1)
                 else:
                     spool.reject(attempt, result.reason or "unknown", seed=result.seed, steps=result.steps)
                     stats.reasons[result.reason] = stats.reasons.get(result.reason, 0) + 1

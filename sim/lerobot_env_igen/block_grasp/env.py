@@ -147,6 +147,11 @@ class BlockGraspEnv(TaskEnv):
     def true_object_poses(self) -> dict[str, np.ndarray]:
         return {"cube": self._true_cube_pose()}
 
+    def true_object_pose_vector(self) -> np.ndarray:
+        # recorded on every frame: read MuJoCo's body quaternion instead of converting a matrix
+        quat_wxyz = self.data.xquat[self._cube_body]
+        return np.array([*self.data.xpos[self._cube_body], quat_wxyz[1], quat_wxyz[2], quat_wxyz[3], quat_wxyz[0]])
+
     def _believed_cube_pos(self) -> np.ndarray:
         true_pos = self.data.xpos[self._cube_body]
         if not self._revealed or self.reveal_mode is Reveal.NONE:
