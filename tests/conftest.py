@@ -60,3 +60,12 @@ def source_demos(tmp_path_factory, block_grasp_config):
 def source_interventions(tmp_path_factory, block_grasp_config):
     """10 human-gated (scripted operator) interventions, written as an igen dataset."""
     return _record_sources(tmp_path_factory, block_grasp_config, "interventions", 10, seed=200)
+
+
+@pytest.fixture(scope="session")
+def bc_rnn_checkpoint(source_demos, tmp_path_factory):
+    """A BC-RNN checkpoint made by lerobot-train (3 steps: the plumbing, not a good policy)."""
+    from igen_lerobot.training import TrainConfig, lerobot_train
+
+    cfg = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)
+    return lerobot_train(cfg, source_demos, "local/block_grasp_demos", tmp_path_factory.mktemp("train") / "bc_rnn")

@@ -5,13 +5,6 @@ import pytest
 import torch
 
 from igen_lerobot.dataset.reader import load_episodes
-from igen_lerobot.training import TrainConfig, lerobot_train
-
-
-@pytest.fixture(scope="session")
-def bc_rnn_checkpoint(source_demos, tmp_path_factory):
-    cfg = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)
-    return lerobot_train(cfg, source_demos, "local/block_grasp_demos", tmp_path_factory.mktemp("train") / "bc_rnn")
 
 
 def test_bc_rnn_is_found_by_lerobot_plugin_discovery():

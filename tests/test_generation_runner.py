@@ -166,3 +166,28 @@ def test_igen_generate_cli_end_to_end(source_interventions, source_demos, tmp_pa
         env={**os.environ, "MUJOCO_GL": "egl"},
     )
     assert bad.returncode == 2 and "no intervention frames" in bad.stderr
+
+
+def test_worker_processes_load_a_plugin_policy_checkpoint(job, bc_rnn_checkpoint, tmp_path):
+    """Each worker registers LeRobot plugins itself before loading the bc_rnn checkpoint."""
+    import dataclasses
+
+    from igen_lerobot.policies.source import PolicySourceConfig
+
+    with_policy = dataclasses.replace(job, policy=PolicySourceConfig(path=str(bc_rnn_checkpoint)), max_steps=320)
+    spool = EpisodeSpool(tmp_path / "attempts")
+    stats = run_generation(with_policy, spool, 2, workers=2)
+    assert stats.kept >= 2
+    assert not any(reason.startswith("error") for reason in stats.reasons)
+
+
+def test_a_job_whose_workers_cannot_start_stops_with_their_error(job, tmp_path):
+    import dataclasses
+
+    from igen_lerobot.generation.runner import GenerationSetupError
+    from igen_lerobot.policies.source import PolicySourceConfig
+
+    broken = dataclasses.replace(job, policy=PolicySourceConfig(path=str(tmp_path / "no_such_checkpoint")))
+    with pytest.raises(GenerationSetupError, match="has no config.json"):
+        run_generation(broken, EpisodeSpool(tmp_path / "attempts"), 2, workers=2)
+    assert not mp.active_children()

@@ -19,6 +19,7 @@ import contextlib
 import logging
 import multiprocessing as mp
 import time
+import traceback
 from collections import deque
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -27,13 +28,20 @@ from multiprocessing.connection import Connection, wait
 from tqdm import tqdm
 
 from igen_lerobot.dataset.spool import EpisodeSpool
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.exceptions import ConfigError, IgenError
 from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.job import AttemptRunner, GenerationJob, limit_threads
 
 logger = logging.getLogger(__name__)
 
 BACKENDS = ("local", "ray")
+SETUP_FAILED = "setup_failed"
+MAX_ERRORS_BEFORE_FIRST_KEPT = 5  # attempts that raise, with nothing kept yet: a broken job, not bad luck
+MAX_RESTARTS_WITHOUT_PROGRESS = 3  # per worker
+
+
+class GenerationSetupError(IgenError, RuntimeError):
+    """The generation job cannot run (a worker cannot start, or every attempt raises)."""
 
 
 @dataclass
@@ -102,14 +110,24 @@ def _run_safely(runner: AttemptRunner, attempt: int) -> Attempt:
         return runner(attempt)
     except Exception as error:  # noqa: BLE001 - a failing attempt is counted and logged, not a crash
         logger.exception("attempt %d raised", attempt)
-        return Attempt(seed=-1, episode=None, reason=f"error: {type(error).__name__}", steps=0)
+        return Attempt(
+            seed=-1,
+            episode=None,
+            reason=f"error: {type(error).__name__}",
+            steps=0,
+            details={"error": f"{type(error).__name__}: {error}"[:2000]},
+        )
 
 
 def _worker_loop(
     job: GenerationJob, spool_dir: str, tasks: Connection, results: Connection
 ) -> None:  # pragma: no cover
     limit_threads()
-    runner = AttemptRunner(job)
+    try:
+        runner = AttemptRunner(job)
+    except Exception:  # noqa: BLE001 - reported to the parent, which stops the run with it
+        results.send((SETUP_FAILED, traceback.format_exc()[-3000:]))
+        return
     spool = EpisodeSpool(spool_dir)
     while (attempt := tasks.recv()) is not None:
         result = _run_safely(runner, attempt)
@@ -173,6 +191,8 @@ class _LocalPool:
                 attempt, result = reader.recv()
             except (EOFError, OSError):
                 continue  # the worker died; reap_dead reschedules its attempts
+            if attempt == SETUP_FAILED:
+                raise GenerationSetupError(f"a generation worker could not start:\n{result}")
             worker.assigned.discard(attempt)
             yield attempt, result
 
@@ -329,6 +349,7 @@ def run_generation(
         pool = _LocalPool(job, workers, spool)
     start = time.perf_counter()
     bar = tqdm(total=num_episodes, initial=dispatcher.kept, desc=f"generating ({job.mode.value})", unit="ep")
+    errors, restarts_without_progress = 0, 0
     try:
         while True:
             while pool.in_flight() < pool.capacity() and (attempt := dispatcher.next_attempt()) is not None:
@@ -344,8 +365,17 @@ def run_generation(
                     if bar.n < num_episodes:  # attempts already in flight may keep a few extra
                         bar.update(1)
                 else:
-                    spool.reject(attempt, result.reason or "unknown", seed=result.seed, steps=result.steps)
                     stats.reasons[result.reason] = stats.reasons.get(result.reason, 0) + 1
+                    if "error" not in result.details:
+                        spool.reject(attempt, result.reason or "unknown", seed=result.seed, steps=result.steps)
+                    else:  # not spooled: a resumed run (after the cause is fixed) tries it again
+                        errors += 1
+                        if errors >= MAX_ERRORS_BEFORE_FIRST_KEPT and stats.kept + stats.resumed_kept == 0:
+                            raise GenerationSetupError(
+                                f"{errors} attempts raised and none succeeded; the last error: "
+                                f"{result.details['error']} (see the log for tracebacks)"
+                            )
+                restarts_without_progress = 0
                 stats.attempted += 1
                 stats.steps += result.steps
                 dispatcher.finished(attempt, result.kept)
@@ -354,7 +384,15 @@ def run_generation(
                 bar.set_postfix(
                     attempts=stats.attempted + stats.resumed_attempts, success=f"{100 * stats.success_rate:.0f}%"
                 )
-            for attempt in pool.reap_dead():
+            lost = pool.reap_dead()
+            if lost:
+                restarts_without_progress += 1
+                if restarts_without_progress > MAX_RESTARTS_WITHOUT_PROGRESS * workers:
+                    raise GenerationSetupError(
+                        f"generation workers died {restarts_without_progress} times in a row without finishing an "
+                        "attempt; see the log above for their errors"
+                    )
+            for attempt in lost:
                 stats.respawned_workers += 1
                 dispatcher.retry.append(attempt)
     finally:

@@ -43,6 +43,11 @@ class LeRobotCheckpointPolicy:
         import torch
         from lerobot.configs.policies import PreTrainedConfig
         from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+        from lerobot.utils.import_utils import register_third_party_plugins
+
+        # Plugin policy types (bc_rnn) must be registered in every process that loads one,
+        # generation workers included, not only in the one that parsed the command line.
+        register_third_party_plugins()
 
         path = Path(path)
         if not (path / "config.json").exists():
