@@ -131,6 +131,45 @@ def _check_episode(ep: Episode, index: int, spec: TaskSpec) -> None:
         )
 
 
+def _parse(
+    episodes: Sequence[Episode],
+    spec: TaskSpec,
+    target_from_action: TargetFromAction,
+    gripper_from_action: GripperFromAction,
+    interventions: bool,
+) -> SourceLibrary:
+    """Cut every checked episode into runs of constant subtask (and, for interventions, actor)."""
+    if not episodes:
+        raise DatasetSchemaError("the source dataset has no episodes")
+    library = SourceLibrary(spec=spec, episodes=len(episodes))
+    for index, ep in enumerate(episodes):
+        _check_episode(ep, index, spec)
+        if interventions and not np.any(ep.is_intervention):
+            raise DatasetSchemaError(
+                f"source episode {index} (seed {ep.seed}, kind {ep.kind!r}) has no intervention frames "
+                "(complementary_info.is_intervention is never set); IntervenGen needs recorded recoveries: "
+                "record them with igen-collect --mode=interventions"
+            )
+        key = ep.subtask * 2 + (ep.is_intervention.astype(np.int64) if interventions else 0)
+        for start, end in _runs(key):
+            operator = interventions and bool(ep.is_intervention[start])
+            if operator and not np.all(ep.source[start:end] != FrameSource.POLICY):
+                raise DatasetSchemaError(f"source episode {index}: flagged frames {start}..{end} include policy frames")
+            role = (SegmentRole.RECOVERY if operator else SegmentRole.MISTAKE) if interventions else SegmentRole.SUBTASK
+            segment = _segment(
+                ep,
+                index,
+                slice(start, end),
+                int(ep.subtask[start]),
+                role,
+                spec,
+                target_from_action,
+                gripper_from_action,
+            )
+            library.segments.append(segment)
+    return library
+
+
 def parse_demos(
     episodes: Sequence[Episode],
     spec: TaskSpec,
@@ -138,25 +177,7 @@ def parse_demos(
     gripper_from_action: GripperFromAction,
 ) -> SourceLibrary:
     """One :attr:`SegmentRole.SUBTASK` segment per subtask of every demonstration."""
-    if not episodes:
-        raise DatasetSchemaError("the source dataset has no episodes")
-    library = SourceLibrary(spec=spec, episodes=len(episodes))
-    for index, ep in enumerate(episodes):
-        _check_episode(ep, index, spec)
-        for start, end in _runs(ep.subtask):
-            library.segments.append(
-                _segment(
-                    ep,
-                    index,
-                    slice(start, end),
-                    int(ep.subtask[start]),
-                    SegmentRole.SUBTASK,
-                    spec,
-                    target_from_action,
-                    gripper_from_action,
-                )
-            )
-    return library
+    return _parse(episodes, spec, target_from_action, gripper_from_action, interventions=False)
 
 
 def parse_interventions(
@@ -166,34 +187,4 @@ def parse_interventions(
     gripper_from_action: GripperFromAction,
 ) -> SourceLibrary:
     """Mistake (policy) and recovery (operator) segments per subtask of every intervention episode."""
-    if not episodes:
-        raise DatasetSchemaError("the source dataset has no episodes")
-    library = SourceLibrary(spec=spec, episodes=len(episodes))
-    for index, ep in enumerate(episodes):
-        _check_episode(ep, index, spec)
-        if not np.any(ep.is_intervention):
-            raise DatasetSchemaError(
-                f"source episode {index} (seed {ep.seed}, kind {ep.kind!r}) has no intervention frames "
-                "(complementary_info.is_intervention is never set); IntervenGen needs recorded recoveries: "
-                "record them with igen-collect --mode=interventions"
-            )
-        # a new segment wherever the subtask or the actor changes
-        key = ep.subtask * 2 + ep.is_intervention.astype(np.int64)
-        for start, end in _runs(key):
-            operator = bool(ep.is_intervention[start])
-            if operator and not np.all(ep.source[start:end] != FrameSource.POLICY):
-                raise DatasetSchemaError(f"source episode {index}: flagged frames {start}..{end} include policy frames")
-            role = SegmentRole.RECOVERY if operator else SegmentRole.MISTAKE
-            library.segments.append(
-                _segment(
-                    ep,
-                    index,
-                    slice(start, end),
-                    int(ep.subtask[start]),
-                    role,
-                    spec,
-                    target_from_action,
-                    gripper_from_action,
-                )
-            )
-    return library
+    return _parse(episodes, spec, target_from_action, gripper_from_action, interventions=True)
