@@ -14,6 +14,7 @@ from igen_lerobot.policies.source import PolicySourceConfig
 
 MODES = ("demos", "interventions")
 OPERATORS = ("scripted", "teleop")
+DEMO_OBSERVATIONS = ("true", "corrupted")
 
 
 @dataclass
@@ -41,6 +42,9 @@ class CollectConfig:
     num_episodes: int = 10
     seed: int = 0
     max_attempts: int = 0  # attempts before giving up (0: 5 x num_episodes)
+    # demos only: "true" records true poses (base data); "corrupted" records what the robot believes
+    # under env.corruption while the operator still acts on the truth (the paper's test-time "Source Demo")
+    demo_observation: str = "true"
     operator: str = "scripted"  # "scripted" (sees true poses) or "teleop" (a person, --teleop.type=...)
     teleop: TeleoperatorConfig | None = None
     teleop_step: float = 0.01  # [m] controller-goal offset per teleop key step
@@ -58,6 +62,12 @@ class CollectConfig:
             )
         if self.mode not in MODES:
             raise ConfigError(f"--mode must be one of {MODES}, got {self.mode!r}")
+        if self.demo_observation not in DEMO_OBSERVATIONS:
+            raise ConfigError(f"--demo_observation must be one of {DEMO_OBSERVATIONS}, got {self.demo_observation!r}")
+        if self.demo_observation == "corrupted" and self.mode != "demos":
+            raise ConfigError(
+                "--demo_observation only applies to --mode=demos (interventions always observe corruption)"
+            )
         if self.operator not in OPERATORS:
             raise ConfigError(f"--operator must be one of {OPERATORS}, got {self.operator!r}")
         if self.operator == "teleop" and self.teleop is None:

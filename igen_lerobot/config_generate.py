@@ -39,6 +39,9 @@ class GenerateConfig:
     ray_address: str | None = None  # an existing Ray cluster; None starts a local one
     max_attempts: int = 0  # 0: 20 x num_episodes
     policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)
+    # mimicgen only: "true" observes true poses (base data); "corrupted" records the robot's belief under
+    # env.corruption, as test-time demonstrations do (the paper's "MG Demo" baseline)
+    demo_observation: str = "true"
     mimicgen: MimicGenConfig = field(default_factory=MimicGenConfig)
     igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
     merge_with: str | None = None  # root of a base dataset to aggregate the generated episodes with
@@ -60,6 +63,10 @@ class GenerateConfig:
             raise ConfigError("--source.root is required: the igen-collect dataset to generate from")
         if self.num_episodes < 1:
             raise ConfigError(f"--num_episodes must be >= 1, got {self.num_episodes}")
+        if self.demo_observation not in ("true", "corrupted"):
+            raise ConfigError(f"--demo_observation must be 'true' or 'corrupted', got {self.demo_observation!r}")
+        if self.demo_observation == "corrupted" and self.mode != GenerationMode.MIMICGEN:
+            raise ConfigError("--demo_observation only applies to --mode=mimicgen")
         if self.workers < 1:
             raise ConfigError(f"--workers must be >= 1, got {self.workers}")
         if self.backend not in BACKENDS:

@@ -28,6 +28,7 @@ class TrainConfig:
     num_workers: int = 2
     device: str = "cpu"
     seed: int = 1000
+    save_freq: int = 0  # checkpoint every this many steps (0: only at the end); igen-eval picks the best
     extra_args: list[str] = field(default_factory=list)  # passed verbatim, e.g. ["--policy.horizon=10"]
 
     def __post_init__(self) -> None:
@@ -35,11 +36,33 @@ class TrainConfig:
             raise ConfigError(f"train.steps must be >= 1, got {self.steps}")
         if self.batch_size < 1:
             raise ConfigError(f"train.batch_size must be >= 1, got {self.batch_size}")
+        if self.save_freq < 0:
+            raise ConfigError(f"train.save_freq must be >= 0 (0: only the last step), got {self.save_freq}")
 
 
 def checkpoint_path(output_dir: Path) -> Path:
     """The ``pretrained_model/`` folder of the last checkpoint of a lerobot-train run."""
     return Path(output_dir) / "checkpoints" / "last" / "pretrained_model"
+
+
+def train_command(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir: Path) -> list[str]:
+    """The ``lerobot-train`` command line, as a user would type it."""
+    return [
+        str(Path(sys.executable).parent / "lerobot-train"),
+        f"--policy.type={cfg.policy_type}",
+        f"--policy.device={cfg.device}",
+        "--policy.push_to_hub=false",
+        f"--dataset.repo_id={repo_id}",
+        f"--dataset.root={dataset_root}",
+        f"--output_dir={output_dir}",
+        f"--steps={cfg.steps}",
+        f"--batch_size={cfg.batch_size}",
+        f"--num_workers={cfg.num_workers}",
+        f"--save_freq={cfg.save_freq or cfg.steps}",
+        f"--seed={cfg.seed}",
+        "--wandb.enable=false",
+        *cfg.extra_args,
+    ]
 
 
 def lerobot_train(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir: Path) -> Path:
@@ -53,22 +76,7 @@ def lerobot_train(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir
         import shutil
 
         shutil.rmtree(output_dir)
-    command = [
-        str(Path(sys.executable).parent / "lerobot-train"),
-        f"--policy.type={cfg.policy_type}",
-        f"--policy.device={cfg.device}",
-        "--policy.push_to_hub=false",
-        f"--dataset.repo_id={repo_id}",
-        f"--dataset.root={dataset_root}",
-        f"--output_dir={output_dir}",
-        f"--steps={cfg.steps}",
-        f"--batch_size={cfg.batch_size}",
-        f"--num_workers={cfg.num_workers}",
-        f"--save_freq={cfg.steps}",
-        f"--seed={cfg.seed}",
-        "--wandb.enable=false",
-        *cfg.extra_args,
-    ]
+    command = train_command(cfg, dataset_root, repo_id, output_dir)
     logger.info("training: %s", " ".join(command))
     log = output_dir.with_name(output_dir.name + ".log")
     log.parent.mkdir(parents=True, exist_ok=True)

@@ -27,7 +27,8 @@ class MimicGenConfig:
 def generate_demo(env: TaskEnv, library: SourceLibrary, cfg: MimicGenConfig, seed: int, max_steps: int) -> Attempt:
     """Replay one transformed source segment per subtask in the scene of ``seed``; keep it if it succeeds.
 
-    The env must observe true poses (no corruption): these are demonstrations.
+    Segments are placed with the *true* object pose, so the demonstration succeeds whatever the
+    env's corruption; the recorded observation is the robot's belief (true poses for base data).
     """
     rng = np.random.default_rng([seed, 1])
     obs = env.reset(seed)

@@ -50,7 +50,7 @@ def make_operator(cfg: CollectConfig, env_cfg: TaskEnvConfig) -> Operator:
 def collect(cfg: CollectConfig) -> None:
     """Record until ``num_episodes`` are kept, spooling every attempt so a rerun resumes."""
     env_cfg: TaskEnvConfig = cfg.env  # type: ignore[assignment]  # checked in CollectConfig
-    if cfg.mode == "demos" and not isinstance(env_cfg.corruption, NoNoise):
+    if cfg.mode == "demos" and cfg.demo_observation == "true" and not isinstance(env_cfg.corruption, NoNoise):
         logger.info("demos are recorded on true poses: overriding env.corruption with none")
         env_cfg.corruption = NoNoise()
     spec = env_cfg.task_spec

@@ -48,7 +48,11 @@ def generate(cfg: GenerateConfig) -> None:
     """Parse the sources, run the attempts (resumably), write the dataset, optionally merge."""
     env_cfg = cfg.env
     mode = cfg.generation_mode
-    if mode is GenerationMode.MIMICGEN and not isinstance(env_cfg.corruption, NoNoise):
+    if (
+        mode is GenerationMode.MIMICGEN
+        and cfg.demo_observation == "true"
+        and not isinstance(env_cfg.corruption, NoNoise)
+    ):
         logger.info("MimicGen demonstrations observe true poses: overriding env.corruption with none")
         env_cfg = dataclasses.replace(env_cfg, corruption=NoNoise())
     spec = env_cfg.task_spec

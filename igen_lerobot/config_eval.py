@@ -1,0 +1,41 @@
+"""Config of ``igen-eval`` (draccus, LeRobot style)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from lerobot.envs.configs import EnvConfig
+
+from igen_lerobot.env_config import TaskEnvConfig, task_config_class
+from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.policies.source import PolicySourceConfig
+
+EVAL_SEED = 1_000_003  # far from the seeds collection and generation use by default
+
+
+@dataclass
+class EvalConfig:
+    """Success rate over seeded trials under the task's pose error and reveal-on-contact."""
+
+    task: str | None = None  # shortcut for --env.type with the task's defaults (the paper's corruption)
+    env: EnvConfig | None = None
+    policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # one checkpoint (or scripted)
+    train_dir: str | None = None  # a lerobot-train --output_dir: evaluate its checkpoints, report the best
+    every: int = 1  # with --train_dir: every k-th saved checkpoint (the last one always)
+    n_trials: int = 50
+    seed: int = EVAL_SEED
+    output: str | None = None  # JSON file for the results
+
+    def __post_init__(self) -> None:
+        if self.env is None:
+            if self.task is None:
+                raise ConfigError("say which task: --task=block_grasp (or --env.type=block_grasp)")
+            self.env = task_config_class(self.task)()
+        if not isinstance(self.env, TaskEnvConfig):
+            raise ConfigError(f"--env.type={self.env.type} is not an igen task; use e.g. --task=block_grasp")
+        if self.policy.path and self.train_dir:
+            raise ConfigError("give --policy.path (one checkpoint) or --train_dir (all of a run's), not both")
+        if self.n_trials < 1:
+            raise ConfigError(f"--n_trials must be >= 1, got {self.n_trials}")
+        if self.every < 1:
+            raise ConfigError(f"--every must be >= 1, got {self.every}")

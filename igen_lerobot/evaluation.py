@@ -1,0 +1,124 @@
+"""Success rate of a policy under the task's corruption, over seeded trials, with a confidence interval.
+
+The rollout is the one ``lerobot-eval`` does through our gym env (same observation, same
+episode length, same reveal-on-contact), run in-process so that many checkpoints can be
+compared quickly. Trial ``i`` uses scene and corruption :func:`episode_seed` ``(seed, i)``, so every
+checkpoint and every dataset variant meets the same 50 situations.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import re
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from tqdm import tqdm
+
+from igen_lerobot.agents import Policy
+from igen_lerobot.collect import episode_seed
+from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.task import TaskEnv
+
+logger = logging.getLogger(__name__)
+
+
+def wilson_interval(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
+    """95% Wilson score interval of a binomial rate; sensible at 0/50 and 50/50, unlike the normal one."""
+    if trials < 1:
+        raise ConfigError("a success rate needs at least one trial")
+    p = successes / trials
+    denom = 1 + z * z / trials
+    centre = (p + z * z / (2 * trials)) / denom
+    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+@dataclass
+class EvalResult:
+    """Outcome of ``trials`` rollouts of one policy."""
+
+    policy: str
+    trials: int
+    successes: int
+    success_rate: float
+    ci95: tuple[float, float]
+    mean_steps: float
+    seconds: float
+    per_trial: list[bool] = field(default_factory=list)
+    step: int | None = None  # training step of the checkpoint, when known
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+def rollout(env: TaskEnv, policy: Policy, seed: int, max_steps: int) -> tuple[bool, int]:
+    """One closed-loop episode; success ends it early, as in ``lerobot-eval``."""
+    obs = env.reset(seed)
+    policy.reset()
+    for step in range(1, max_steps + 1):
+        if env.step(policy.act(obs)).success:
+            return True, step
+        obs = env.observe()
+    return False, max_steps
+
+
+def evaluate(
+    env: TaskEnv, policy: Policy, name: str, trials: int, seed: int, max_steps: int, progress: bool = True
+) -> EvalResult:
+    """Roll ``policy`` out for ``trials`` seeded trials."""
+    if trials < 1:
+        raise ConfigError(f"eval trials must be >= 1, got {trials}")
+    start = time.perf_counter()
+    outcomes, steps = [], []
+    with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
+        for i in range(trials):
+            success, n = rollout(env, policy, episode_seed(seed, i), max_steps)
+            outcomes.append(success)
+            steps.append(n)
+            bar.update()
+            bar.set_postfix(success=f"{sum(outcomes)}/{len(outcomes)}")
+    successes = sum(outcomes)
+    return EvalResult(
+        policy=name,
+        trials=trials,
+        successes=successes,
+        success_rate=successes / trials,
+        ci95=wilson_interval(successes, trials),
+        mean_steps=sum(steps) / trials,
+        seconds=time.perf_counter() - start,
+        per_trial=outcomes,
+    )
+
+
+_STEP_DIR = re.compile(r"^\d+$")
+
+
+def list_checkpoints(train_dir: Path, every: int = 1) -> list[tuple[int, Path]]:
+    """``(step, pretrained_model/)`` of every ``every``-th checkpoint of a lerobot-train run, last included."""
+    if every < 1:
+        raise ConfigError(f"--every must be >= 1, got {every}")
+    folder = Path(train_dir) / "checkpoints"
+    if not folder.is_dir():
+        raise ConfigError(
+            f"{train_dir} has no checkpoints/ folder; point --train_dir at a lerobot-train --output_dir "
+            "(checkpoints are saved every --save_freq steps)"
+        )
+    found = sorted(
+        (int(p.name), p / "pretrained_model")
+        for p in folder.iterdir()
+        if _STEP_DIR.match(p.name) and (p / "pretrained_model" / "config.json").exists()
+    )
+    if not found:
+        raise ConfigError(f"{folder} holds no finished checkpoint (no <step>/pretrained_model/config.json)")
+    chosen = found[every - 1 :: every]
+    if found[-1] not in chosen:
+        chosen.append(found[-1])
+    return chosen
+
+
+def best_result(results: list[EvalResult]) -> EvalResult:
+    """The highest success rate (the paper reports the best checkpoint); ties go to the later checkpoint."""
+    return max(results, key=lambda r: (r.success_rate, r.step or 0))

@@ -1,0 +1,107 @@
+"""igen-eval: seeded trials, confidence intervals, checkpoint selection, bad input."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from igen_lerobot.evaluation import EvalResult, best_result, evaluate, list_checkpoints, wilson_interval
+from igen_lerobot.exceptions import ConfigError
+
+BIN = Path(sys.executable).parent
+ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
+
+
+@pytest.mark.parametrize(
+    ("successes", "trials", "expected"),
+    # reference values of the 95% Wilson score interval (z = 1.96)
+    [(0, 50, (0.0, 0.0713)), (50, 50, (0.9287, 1.0)), (25, 50, (0.3664, 0.6336)), (3, 10, (0.1078, 0.6032))],
+)
+def test_wilson_interval_matches_reference_values(successes, trials, expected):
+    low, high = wilson_interval(successes, trials)
+    assert low == pytest.approx(expected[0], abs=1e-3)
+    assert high == pytest.approx(expected[1], abs=1e-3)
+
+
+def test_wilson_interval_needs_a_trial():
+    with pytest.raises(ConfigError, match="at least one trial"):
+        wilson_interval(0, 0)
+
+
+def _fake_run(root: Path, steps: list[int]) -> Path:
+    """The checkpoint layout lerobot-train writes: checkpoints/<step:06d>/pretrained_model/config.json."""
+    for step in steps:
+        model = root / "checkpoints" / f"{step:06d}" / "pretrained_model"
+        model.mkdir(parents=True)
+        (model / "config.json").write_text("{}")
+    (root / "checkpoints" / "000099").mkdir()  # an unfinished checkpoint: no pretrained_model yet
+    return root
+
+
+def test_every_kth_checkpoint_and_always_the_last(tmp_path):
+    run = _fake_run(tmp_path / "run", [2, 4, 6, 8, 10])
+    assert [s for s, _ in list_checkpoints(run, every=1)] == [2, 4, 6, 8, 10]
+    assert [s for s, _ in list_checkpoints(run, every=2)] == [4, 8, 10]
+    assert [s for s, _ in list_checkpoints(run, every=3)] == [6, 10]
+    with pytest.raises(ConfigError, match="no checkpoints/ folder"):
+        list_checkpoints(tmp_path / "nothing")
+
+
+def test_best_checkpoint_is_the_highest_rate_ties_to_the_later():
+    def result(step, rate):
+        return EvalResult("p", 10, int(rate * 10), rate, (0, 1), 1.0, 0.0, step=step)
+
+    assert best_result([result(1, 0.2), result(2, 0.6), result(3, 0.4)]).step == 2
+    assert best_result([result(1, 0.6), result(2, 0.6)]).step == 2
+
+
+def test_seeded_trials_are_reproducible(block_grasp_config, block_grasp_env):
+    policy = block_grasp_config.make_scripted_policy()
+    first = evaluate(block_grasp_env, policy, "scripted", 4, seed=7, max_steps=200, progress=False)
+    again = evaluate(block_grasp_env, policy, "scripted", 4, seed=7, max_steps=200, progress=False)
+    assert first.per_trial == again.per_trial
+    assert first.successes == sum(first.per_trial)
+    assert first.success_rate == pytest.approx(first.successes / 4)
+    assert first.mean_steps == again.mean_steps
+
+
+def test_igen_eval_evaluates_a_lerobot_train_run(bc_rnn_checkpoint, tmp_path):
+    train_dir = bc_rnn_checkpoint.parents[2]  # .../<run>/checkpoints/last/pretrained_model
+    out = tmp_path / "eval.json"
+    result = subprocess.run(
+        [str(BIN / "igen-eval"), "--task=block_grasp", f"--train_dir={train_dir}", "--n_trials=2", f"--output={out}"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env=ENV,
+    )
+    assert result.returncode == 0, result.stderr[-3000:]
+    report = json.loads(out.read_text())
+    assert report["n_trials"] == 2 and report["corruption"]["type"] == "box"
+    [only] = report["results"]
+    assert only["step"] == 3 and only["trials"] == 2 and len(only["per_trial"]) == 2
+    assert report["best"]["step"] == 3
+    assert "step 3:" in result.stdout and "95% CI" in result.stdout
+
+
+def test_igen_eval_bad_input_names_the_fix(tmp_path):
+    run = subprocess.run(
+        [str(BIN / "igen-eval"), "--task=block_grasp", f"--train_dir={tmp_path}"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=ENV,
+    )
+    assert run.returncode == 2
+    assert "no checkpoints/ folder" in run.stderr and "--train_dir" in run.stderr
+    both = subprocess.run(
+        [str(BIN / "igen-eval"), "--task=block_grasp", f"--train_dir={tmp_path}", f"--policy.path={tmp_path}"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=ENV,
+    )
+    assert both.returncode == 2 and "not both" in both.stderr
