@@ -81,8 +81,8 @@ def inference(checkpoint: Path, n: int = 2000) -> dict:
 
 
 def evaluation(checkpoint: Path, trials: int = 10) -> dict:
-    from igen_lerobot.evaluation import evaluate
     from igen_lerobot.env_config import task_config_class
+    from igen_lerobot.evaluation import evaluate
     from igen_lerobot.policies.lerobot_checkpoint import LeRobotCheckpointPolicy
 
     cfg = task_config_class("block_grasp")()
