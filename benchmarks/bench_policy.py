@@ -1,6 +1,6 @@
 r"""BC-RNN on this CPU: training throughput, inference latency, evaluation rollouts (issue: policies).
 
-Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_policy.py --dataset outputs/demo/mg_demos \
+Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_policy.py [--dataset outputs/demo/mg_demos] \
           [--checkpoint outputs/demo/loop/iter_0/train/checkpoints/last/pretrained_model] [--steps 60]
 
 1. training: ``lerobot-train --policy.type=bc_rnn`` for ``--steps`` steps (batch 100, 2 loader workers);
@@ -100,12 +100,14 @@ def evaluation(checkpoint: Path, trials: int = 10) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--dataset", type=Path, required=True)
+    parser.add_argument("--dataset", type=Path, default=None, help="train on it (omit to skip training)")
     parser.add_argument("--checkpoint", type=Path, default=None)
     parser.add_argument("--steps", type=int, default=60)
     args = parser.parse_args()
-    results = {"training": training(args.dataset, args.steps)}
-    print(json.dumps(results, indent=2), flush=True)
+    results = {}
+    if args.dataset:
+        results["training"] = training(args.dataset, args.steps)
+        print(json.dumps(results, indent=2), flush=True)
     if args.checkpoint:
         results["inference"] = inference(args.checkpoint)
         results["evaluation"] = evaluation(args.checkpoint)

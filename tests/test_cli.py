@@ -143,3 +143,44 @@ def test_lerobot_train_and_eval_run_on_our_dataset_and_env(tmp_path):
     info = json.loads((tmp_path / "eval/eval_info.json").read_text())
     assert info["overall"]["n_episodes"] == 1
     assert (tmp_path / "eval/videos/block_grasp_0/eval_episode_0.mp4").stat().st_size > 1000
+
+
+def test_lerobot_diffusion_trains_on_environment_state_and_runs_in_igen_eval(tmp_path):
+    """LeRobot's diffusion policy (state + environment_state, no images) on our data and env."""
+    demos = run(collect_cmd(tmp_path / "demos", 2, mode="demos"))
+    assert demos.returncode == 0, demos.stderr[-3000:]
+    train = run(
+        [
+            str(BIN / "lerobot-train"),
+            "--policy.type=diffusion",
+            "--policy.down_dims=[32,64]",  # a small U-Net and few denoising steps: plumbing, not quality
+            "--policy.num_inference_steps=2",
+            "--dataset.repo_id=local/cli",
+            f"--dataset.root={tmp_path / 'demos'}",
+            "--steps=1",
+            "--batch_size=2",
+            "--policy.device=cpu",
+            f"--output_dir={tmp_path / 'train'}",
+            "--policy.push_to_hub=false",
+            "--save_freq=1",
+            "--num_workers=0",
+            "--wandb.enable=false",
+        ]
+    )
+    assert train.returncode == 0, train.stderr[-3000:]
+    out = tmp_path / "eval.json"
+    evaluation = run(
+        [
+            str(BIN / "igen-eval"),
+            "--env.type=block_grasp",
+            "--env.episode_length=12",
+            f"--policy.path={tmp_path / 'train/checkpoints/last/pretrained_model'}",
+            "--n_trials=1",
+            f"--output={out}",
+        ]
+    )
+    assert evaluation.returncode == 0, evaluation.stderr[-3000:]
+    import json
+
+    report = json.loads(out.read_text())
+    assert report["best"]["trials"] == 1 and report["best"]["mean_steps"] <= 12
