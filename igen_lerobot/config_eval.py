@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 from lerobot.envs.configs import EnvConfig
 
-from igen_lerobot.env_config import TaskEnvConfig, task_config_class
+from igen_lerobot.env_config import resolve_task_env
 from igen_lerobot.exceptions import ConfigError
 from igen_lerobot.policies.source import PolicySourceConfig
 
@@ -27,12 +27,7 @@ class EvalConfig:
     output: str | None = None  # JSON file for the results
 
     def __post_init__(self) -> None:
-        if self.env is None:
-            if self.task is None:
-                raise ConfigError("say which task: --task=block_grasp (or --env.type=block_grasp)")
-            self.env = task_config_class(self.task)()
-        if not isinstance(self.env, TaskEnvConfig):
-            raise ConfigError(f"--env.type={self.env.type} is not an igen task; use e.g. --task=block_grasp")
+        self.env = resolve_task_env(self.task, self.env)
         if self.policy.path and self.train_dir:
             raise ConfigError("give --policy.path (one checkpoint) or --train_dir (all of a run's), not both")
         if self.n_trials < 1:

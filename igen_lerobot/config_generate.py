@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from lerobot.envs.configs import EnvConfig
 
 from igen_lerobot.config_collect import DatasetOutputConfig
-from igen_lerobot.env_config import TaskEnvConfig, task_config_class
+from igen_lerobot.env_config import resolve_task_env
 from igen_lerobot.exceptions import ConfigError
 from igen_lerobot.generation.intervengen import IntervenGenConfig
 from igen_lerobot.generation.job import GenerationMode
@@ -51,14 +51,7 @@ class GenerateConfig:
         modes = tuple(m.value for m in GenerationMode)
         if self.mode not in modes:
             raise ConfigError(f"--mode must be one of {modes}, got {self.mode!r}")
-        if self.env is None:
-            if self.task is None:
-                raise ConfigError("say which task: --task=block_grasp (or --env.type=block_grasp)")
-            self.env = task_config_class(self.task)()
-        if not isinstance(self.env, TaskEnvConfig):
-            raise ConfigError(f"--env.type={self.env.type} is not an igen task; use e.g. --task=block_grasp")
-        if self.task is not None and self.task != self.env.type:
-            raise ConfigError(f"--task={self.task} disagrees with --env.type={self.env.type}; give one of them")
+        self.env = resolve_task_env(self.task, self.env)
         if self.source.root is None:
             raise ConfigError("--source.root is required: the igen-collect dataset to generate from")
         if self.num_episodes < 1:

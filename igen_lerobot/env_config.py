@@ -15,10 +15,10 @@ from lerobot.envs.configs import EnvConfig
 
 from igen_lerobot.agents import Operator, Policy
 from igen_lerobot.corruption import BoxNoise, PoseNoise, Reveal
-from igen_lerobot.exceptions import UnknownTaskError
+from igen_lerobot.exceptions import ConfigError, UnknownTaskError
 from igen_lerobot.task import TaskEnv, TaskSpec
 
-__all__ = ["TaskEnvConfig", "known_tasks", "task_config_class"]
+__all__ = ["TaskEnvConfig", "known_tasks", "resolve_task_env", "task_config_class"]
 
 
 @dataclass
@@ -65,6 +65,19 @@ def known_tasks() -> dict[str, type[TaskEnvConfig]]:
         for name, cls in EnvConfig.get_known_choices().items()
         if isinstance(cls, type) and issubclass(cls, TaskEnvConfig)
     }
+
+
+def resolve_task_env(task: str | None, env: EnvConfig | None) -> TaskEnvConfig:
+    """The task config from ``--task`` (the task's defaults) or ``--env.type`` (with overrides)."""
+    if env is None:
+        if task is None:
+            raise ConfigError("say which task: --task=block_grasp (or --env.type=block_grasp)")
+        env = task_config_class(task)()
+    if not isinstance(env, TaskEnvConfig):
+        raise ConfigError(f"--env.type={env.type} is not an igen task; use e.g. --task=block_grasp")
+    if task is not None and task != env.type:
+        raise ConfigError(f"--task={task} disagrees with --env.type={env.type}; give one of them")
+    return env
 
 
 def task_config_class(name: str) -> type[TaskEnvConfig]:

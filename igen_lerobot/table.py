@@ -29,7 +29,7 @@ from pathlib import Path
 
 from igen_lerobot.config_table import TableConfig
 from igen_lerobot.exceptions import IgenError
-from igen_lerobot.training import train_command
+from igen_lerobot.training import clear_interrupted_run, train_command
 
 logger = logging.getLogger(__name__)
 
@@ -247,10 +247,7 @@ def train(run: TableRun, variant: str, dataset: Path) -> Path:
     """``lerobot-train`` on a variant's dataset (same config for all); returns the last checkpoint."""
     out = run.out / "train" / variant
     done = out / "checkpoints" / "last" / "pretrained_model" / "config.json"
-    if not done.exists() and out.exists():  # interrupted: lerobot-train refuses an existing output_dir
-        import shutil
-
-        shutil.rmtree(out)
+    clear_interrupted_run(out)
     run.run(f"train_{variant}", train_command(run.cfg.train, dataset, f"local/{dataset.name}", out), done)
     return done.parent
 

@@ -45,6 +45,16 @@ def checkpoint_path(output_dir: Path) -> Path:
     return Path(output_dir) / "checkpoints" / "last" / "pretrained_model"
 
 
+def clear_interrupted_run(output_dir: Path) -> None:
+    """Remove a run that stopped before its last checkpoint: lerobot-train refuses an existing output_dir."""
+    output_dir = Path(output_dir)
+    if output_dir.exists() and not (checkpoint_path(output_dir) / "config.json").exists():
+        import shutil
+
+        logger.info("removing the interrupted training run %s", output_dir)
+        shutil.rmtree(output_dir)
+
+
 def train_command(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir: Path) -> list[str]:
     """The ``lerobot-train`` command line, as a user would type it."""
     return [
@@ -72,10 +82,7 @@ def lerobot_train(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir
     if (done / "config.json").exists():
         logger.info("training already done: %s", done)
         return done
-    if output_dir.exists():  # a run interrupted before its last checkpoint: lerobot-train refuses to reuse it
-        import shutil
-
-        shutil.rmtree(output_dir)
+    clear_interrupted_run(output_dir)
     command = train_command(cfg, dataset_root, repo_id, output_dir)
     logger.info("training: %s", " ".join(command))
     log = output_dir.with_name(output_dir.name + ".log")

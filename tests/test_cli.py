@@ -33,6 +33,25 @@ def collect_cmd(root, n, seed=5, mode="interventions"):
     ]
 
 
+def lerobot_train_cmd(tmp_path, policy_type, steps, *extra):
+    """LeRobot's own lerobot-train on the demos recorded under tmp_path/demos, a few CPU steps."""
+    return [
+        str(BIN / "lerobot-train"),
+        f"--policy.type={policy_type}",
+        *extra,
+        "--dataset.repo_id=local/cli",
+        f"--dataset.root={tmp_path / 'demos'}",
+        f"--steps={steps}",
+        "--batch_size=2",
+        "--policy.device=cpu",
+        f"--output_dir={tmp_path / 'train'}",
+        "--policy.push_to_hub=false",
+        f"--save_freq={steps}",
+        "--num_workers=0",
+        "--wandb.enable=false",
+    ]
+
+
 @pytest.fixture(scope="module")
 def spec():
     from lerobot_env_igen.block_grasp.spec import SPEC
@@ -107,22 +126,7 @@ def test_collect_cli_reports_bad_flags(tmp_path):
 def test_lerobot_train_and_eval_run_on_our_dataset_and_env(tmp_path):
     demos = run(collect_cmd(tmp_path / "demos", 2, mode="demos"))
     assert demos.returncode == 0, demos.stderr[-3000:]
-    train = run(
-        [
-            str(BIN / "lerobot-train"),
-            "--policy.type=act",
-            "--dataset.repo_id=local/cli",
-            f"--dataset.root={tmp_path / 'demos'}",
-            "--steps=2",
-            "--batch_size=2",
-            "--policy.device=cpu",
-            f"--output_dir={tmp_path / 'train'}",
-            "--policy.push_to_hub=false",
-            "--save_freq=2",
-            "--num_workers=0",
-            "--wandb.enable=false",
-        ]
-    )
+    train = run(lerobot_train_cmd(tmp_path, "act", steps=2))
     assert train.returncode == 0, train.stderr[-3000:]
     checkpoint = tmp_path / "train/checkpoints/last/pretrained_model"
     evaluation = run(
@@ -149,23 +153,9 @@ def test_lerobot_diffusion_trains_on_environment_state_and_runs_in_igen_eval(tmp
     """LeRobot's diffusion policy (state + environment_state, no images) on our data and env."""
     demos = run(collect_cmd(tmp_path / "demos", 2, mode="demos"))
     assert demos.returncode == 0, demos.stderr[-3000:]
+    # a small U-Net and few denoising steps: plumbing, not quality
     train = run(
-        [
-            str(BIN / "lerobot-train"),
-            "--policy.type=diffusion",
-            "--policy.down_dims=[32,64]",  # a small U-Net and few denoising steps: plumbing, not quality
-            "--policy.num_inference_steps=2",
-            "--dataset.repo_id=local/cli",
-            f"--dataset.root={tmp_path / 'demos'}",
-            "--steps=1",
-            "--batch_size=2",
-            "--policy.device=cpu",
-            f"--output_dir={tmp_path / 'train'}",
-            "--policy.push_to_hub=false",
-            "--save_freq=1",
-            "--num_workers=0",
-            "--wandb.enable=false",
-        ]
+        lerobot_train_cmd(tmp_path, "diffusion", 1, "--policy.down_dims=[32,64]", "--policy.num_inference_steps=2")
     )
     assert train.returncode == 0, train.stderr[-3000:]
     out = tmp_path / "eval.json"

@@ -7,9 +7,6 @@ import numpy as np
 import pytest
 
 from igen_lerobot.exceptions import ConfigError
-
-pytest.importorskip("open3d")  # installed by setup; the import itself needs libusb (scripts/setup.sh)
-
 from lerobot_robot_igen.perception.camera_model import Intrinsics, load_extrinsics, save_extrinsics  # noqa: E402
 from lerobot_robot_igen.perception.cube_pose import (  # noqa: E402
     CUBE_SYMMETRIES,

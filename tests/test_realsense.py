@@ -7,8 +7,6 @@ import time
 import numpy as np
 import pytest
 
-pytest.importorskip("pyrealsense2")
-
 from igen_lerobot.exceptions import ConfigError, IgenError  # noqa: E402
 from lerobot_robot_igen.perception.camera_model import Intrinsics  # noqa: E402
 from lerobot_robot_igen.realsense import (  # noqa: E402

@@ -87,10 +87,7 @@ def random_cube_view(
     gripper hides part of it, as during a grasp.
     """
     env.reset(int(rng.integers(2**31)))
-    yaw = np.deg2rad(rng.uniform(-max_yaw_deg, max_yaw_deg))
-    adr = env._cube_qpos
-    env.data.qpos[adr + 3 : adr + 7] = (np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2))
-    mujoco.mj_forward(env.model, env.data)
+    env.set_cube_yaw(np.deg2rad(rng.uniform(-max_yaw_deg, max_yaw_deg)))
     if occlude:
         operator = env_operator(env)
         for _ in range(80):

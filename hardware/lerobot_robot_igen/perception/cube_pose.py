@@ -195,7 +195,7 @@ class CubePoseEstimator:
             raise PerceptionError(f"no dominant table plane ({len(inliers)} of {len(points)} sampled points)")
         return normal, float(d)
 
-    def _initial_pose(self, points: np.ndarray, normal: np.ndarray, d: float) -> np.ndarray:
+    def _initial_pose(self, points: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """Cube z along the table normal; yaw and centre from the min-area rectangle of the points."""
         z = normal
         x_ref = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -241,7 +241,7 @@ class CubePoseEstimator:
             raise CubeNotVisibleError(f"cube not visible: largest red cluster has {len(points)} points")
         cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
 
-        T_init = self._initial_pose(points, normal, d)
+        T_init = self._initial_pose(points, normal)
         result = o3d.pipelines.registration.registration_icp(
             cloud,
             self.model,

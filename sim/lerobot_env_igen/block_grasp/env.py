@@ -97,6 +97,12 @@ class BlockGraspEnv(TaskEnv):
         self._steps = 0
         return self.observe()
 
+    def set_cube_yaw(self, yaw: float) -> None:
+        """Turn the resting cube about the vertical (perception tests need views of a rotated cube)."""
+        adr = self._cube_qpos
+        self.data.qpos[adr + 3 : adr + 7] = (np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2))
+        mujoco.mj_forward(self.model, self.data)
+
     def _checked_corruption(self, corruption: np.ndarray) -> np.ndarray:
         corruption = np.asarray(corruption, dtype=float).reshape(-1)
         if corruption.shape != (3,):
