@@ -33,19 +33,23 @@ coords = st.floats(-1.0, 1.0, allow_nan=False)
 
 
 @given(st.tuples(coords, coords, coords), st.tuples(coords, coords, coords))
-def test_targets_inside_are_speed_limited_and_outside_refused(current, target):
-    guard = SafetyGuard(SafetyLimits())
+def test_targets_are_clamped_near_the_box_refused_far_from_it_and_speed_limited(current, target):
+    limits = SafetyLimits(workspace_min=(-0.25, -0.35, 0.805), workspace_max=(0.25, 0.35, 1.15), clamp_margin=0.05)
+    guard = SafetyGuard(limits)
     current, target = np.array(current), np.array(target)
-    if not guard.inside(target):
+    if not guard.inside(target, margin=0.05):
         with pytest.raises(SafetyViolationError, match="outside the workspace"):
             guard.filter_target(current, target, period=0.05)
         return
     out = guard.filter_target(current, target, period=0.05)
-    assert np.linalg.norm(out - current) <= 0.25 * 0.05 + 1e-12
-    # the limited step points at the target
-    if np.linalg.norm(target - current) > 1e-9:
-        direction = (target - current) / np.linalg.norm(target - current)
+    assert np.linalg.norm(out - current) <= limits.max_speed * 0.05 + 1e-12
+    # the limited step points at the clamped target, which lies in the box
+    clamped = np.clip(target, limits.workspace_min, limits.workspace_max)
+    if np.linalg.norm(clamped - current) > 1e-9:
+        direction = (clamped - current) / np.linalg.norm(clamped - current)
         np.testing.assert_allclose(out - current, direction * np.linalg.norm(out - current), atol=1e-12)
+    if guard.inside(current):  # from inside the box, a step never leaves it (the box is convex)
+        assert guard.inside(out)
 
 
 def test_watchdog_trips_once_after_the_timeout():
@@ -67,3 +71,5 @@ def test_bad_limits_name_the_field():
         SafetyLimits(workspace_min=(0, 0, 0), workspace_max=(0, 1, 1))
     with pytest.raises(ConfigError, match="max_speed"):
         SafetyLimits(max_speed=0)
+    with pytest.raises(ConfigError, match="clamp_margin"):
+        SafetyLimits(clamp_margin=-0.01)

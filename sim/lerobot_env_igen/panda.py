@@ -78,6 +78,7 @@ class PandaArm:
         self.goal_pos = np.zeros(3)
         self.goal_rot = TOP_DOWN_ROT.copy()
         self._gripper_level = -1.0  # -1 open ... +1 closed
+        self.peak_contact_force = 0.0  # [N] see control_period(measure_force=True)
 
     # ------------------------------------------------------------------ kinematics
     def _gripper_geom_ids(self) -> np.ndarray:
@@ -158,11 +159,19 @@ class PandaArm:
         mask[np.asarray(geoms, dtype=int)] = True
         return mask
 
-    def control_period(self, goal_pos: np.ndarray, close_gripper: bool, touch_mask: np.ndarray | None = None) -> bool:
+    def control_period(
+        self,
+        goal_pos: np.ndarray,
+        close_gripper: bool,
+        touch_mask: np.ndarray | None = None,
+        measure_force: bool = False,
+    ) -> bool:
         """Hold ``goal_pos`` (and the top-down orientation) for one control period.
 
         Returns whether the gripper touched any geom in ``touch_mask`` (see :meth:`geom_mask`)
-        at any substep of the period.
+        at any substep of the period. With ``measure_force``, :attr:`peak_contact_force` is the
+        largest :meth:`contact_force` seen during the period (what a real arm's external-force
+        estimate would show).
         """
         self.goal_pos = np.asarray(goal_pos, dtype=float)
         step = GRIPPER_RATE if close_gripper else -GRIPPER_RATE
@@ -170,13 +179,34 @@ class PandaArm:
         self._apply_gripper_ctrl()
         model, data, act = self.model, self.data, self.arm_act
         touched = False
+        self.peak_contact_force = 0.0
         for _ in range(self.substeps):
             mujoco.mj_step1(model, data)
             data.ctrl[act] = self.osc.torques(data, self.goal_pos, self.goal_rot)
             mujoco.mj_step2(model, data)
             if touch_mask is not None and not touched:
                 touched = self.touching(touch_mask)
+            if measure_force:
+                self.peak_contact_force = max(self.peak_contact_force, self.contact_force())
         return touched
+
+    def contact_force(self) -> float:
+        """Magnitude of the net contact force on the hand and fingers from everything else [N]."""
+        ncon = self.data.ncon
+        if ncon == 0:
+            return 0.0
+        total = np.zeros(3)
+        wrench = np.zeros(6)
+        mask = self.gripper_geom_mask
+        for i in range(ncon):
+            contact = self.data.contact[i]
+            g1, g2 = contact.geom1, contact.geom2
+            if mask[g1] == mask[g2]:
+                continue  # not a gripper contact, or the fingers touching each other
+            mujoco.mj_contactForce(self.model, self.data, i, wrench)
+            force = contact.frame.reshape(3, 3).T @ wrench[:3]  # contact frame -> world, acting on geom2
+            total += force if mask[g2] else -force
+        return float(np.linalg.norm(total))
 
     def _contact_mask(self, obj_mask: np.ndarray) -> np.ndarray:
         pairs = self.data.contact.geom[: self.data.ncon]

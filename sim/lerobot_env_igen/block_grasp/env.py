@@ -116,8 +116,17 @@ class BlockGraspEnv(TaskEnv):
         if action.shape != (4,) or not np.all(np.isfinite(action)):
             raise ValueError(f"Block Grasp action must be 4 finite values {SPEC.action_names}, got {action!r}")
         delta = np.clip(action[:3], -self.max_delta, self.max_delta)
-        goal = self.arm.eef_pos() + delta
-        self._contact_now = self.arm.control_period(goal, self.gripper_command(action), self._cube_mask)
+        return self.step_to(self.arm.eef_pos() + delta, self.gripper_command(action))
+
+    def step_to(self, goal_pos: np.ndarray, close_gripper: bool, measure_force: bool = False) -> StepInfo:
+        """One control period towards an absolute end-effector goal (a driver's Cartesian target).
+
+        With ``measure_force`` the arm records the period's peak contact force on the gripper
+        (``self.arm.peak_contact_force``), the simulated counterpart of a real arm's estimate.
+        """
+        self._contact_now = self.arm.control_period(
+            np.asarray(goal_pos, dtype=float), close_gripper, self._cube_mask, measure_force=measure_force
+        )
         self._steps += 1
         if self._contact_now and not self._revealed:
             self._reveal()

@@ -1,0 +1,1 @@
+"""Arm driver backends: each imports its robot library only when built."""

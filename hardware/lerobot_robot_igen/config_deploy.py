@@ -1,0 +1,146 @@
+"""Config of ``igen-deploy`` (draccus, LeRobot style): which arm, which perception, which policy.
+
+``--robot.type=sim`` rehearses on the Block Grasp scene, ``--robot.type=franky`` drives a real
+FR3/Panda; ``--perception.type`` is ``rendered`` (a simulated D415 through the real ICP code),
+``truth`` (the simulator's pose: isolates the loop from perception) or ``realsense``.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+
+import draccus
+import numpy as np
+
+from igen_lerobot.config_eval import EVAL_SEED
+from igen_lerobot.corruption import BoxNoise, PoseNoise, Reveal
+from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.policies.source import PolicySourceConfig
+from lerobot_robot_igen.driver import ArmDriver
+from lerobot_robot_igen.safety import SafetyLimits
+
+# Where a real, table-mounted arm's base sits in the task frame: the table top is z = 0.8 m in
+# training, and the cube region is centred 0.56 m in front of the base, as in the simulator.
+REAL_WORLD_FROM_BASE_XYZ = (-0.56, 0.0, 0.8)
+
+
+@dataclass
+class ArmBackendConfig(draccus.ChoiceRegistry, abc.ABC):
+    """Which arm the loop drives."""
+
+    @property
+    def simulated(self) -> bool:
+        return False
+
+    @abc.abstractmethod
+    def make_driver(self) -> ArmDriver:
+        """The (not yet connected) driver."""
+
+
+@ArmBackendConfig.register_subclass("sim")
+@dataclass
+class SimArmBackendConfig(ArmBackendConfig):
+    """The Block Grasp scene in MuJoCo (rehearsal)."""
+
+    fps: int = 20
+
+    @property
+    def simulated(self) -> bool:
+        return True
+
+    def make_driver(self) -> ArmDriver:
+        from lerobot_robot_igen.backends.mujoco_arm import MujocoArm, MujocoArmConfig
+
+        return MujocoArm(MujocoArmConfig(fps=self.fps))
+
+
+@dataclass
+class PerceptionConfig(draccus.ChoiceRegistry, abc.ABC):
+    """Where the cube pose comes from."""
+
+
+@PerceptionConfig.register_subclass("rendered")
+@dataclass
+class RenderedPerceptionConfig(PerceptionConfig):
+    """A simulated D415 on a tripod in front of the table, through the real ICP estimator (sim only)."""
+
+    distance: float = 0.85  # [m] from the centre of the cube region
+    azimuth_deg: float = 180.0
+    elevation_deg: float = -55.0
+    depth_noise_m: float = 0.001
+
+
+@PerceptionConfig.register_subclass("truth")
+@dataclass
+class TruthPerceptionConfig(PerceptionConfig):
+    """The simulator's true cube pose (sim only)."""
+
+
+@PerceptionConfig.register_subclass("realsense")
+@dataclass
+class RealSensePerceptionConfig(PerceptionConfig):
+    """A D415 (by serial, or the first one found) or a recording, extrinsics from a calibration file."""
+
+    serial: str | None = None
+    recording: str | None = None
+    calibration: str | None = None  # JSON with T_base_camera (see perception/camera_model.py)
+
+    def __post_init__(self) -> None:
+        if not self.calibration:
+            raise ConfigError(
+                "--perception.calibration is required: a JSON file with the camera pose in the robot base "
+                "frame (T_base_camera), e.g. from a hand-eye calibration; see README 'Perception'"
+            )
+
+
+@dataclass
+class DeployConfig:
+    """Run a trained Block Grasp policy on an arm at 20 Hz for N trials."""
+
+    policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # --policy.path=.../pretrained_model
+    robot: ArmBackendConfig = field(default_factory=SimArmBackendConfig)
+    perception: PerceptionConfig = field(default_factory=RenderedPerceptionConfig)
+    trials: int = 10
+    seed: int = EVAL_SEED  # trial i of a rehearsal is igen-eval's trial i (same scene, same pose error)
+    # Test-time pose error on the perceived cube, revealed on contact (real arms; a rehearsal uses
+    # the scene's own error so that it meets igen-eval's situations).
+    corruption: PoseNoise = field(
+        default_factory=lambda: BoxNoise(half_extent=(0.01, 0.07, 0.0), min_abs=(0.0, 0.025, 0.0), require="all")
+    )
+    reveal: Reveal = Reveal.FULL
+    fps: int = 20
+    max_steps: int = 200
+    contact_force_threshold: float = 2.0  # [N]
+    max_pose_age: float = 0.5  # [s]
+    realtime: bool | None = None  # None: real arms pace to the wall clock, rehearsals run as fast as they can
+    safety: SafetyLimits = field(default_factory=SafetyLimits)
+    world_from_base: tuple[float, float, float] = REAL_WORLD_FROM_BASE_XYZ  # real arms; the sim knows its own
+    compare_sim: bool = False  # rehearsal: also run igen-eval's rollout on the same trials and report both
+    prompt: bool | None = None  # None: ask before each real trial (place the cube), never in a rehearsal
+    output: str | None = None  # JSON file for the results
+
+    def __post_init__(self) -> None:
+        if self.trials < 1:
+            raise ConfigError(f"--trials must be >= 1, got {self.trials}")
+        if self.contact_force_threshold < 0:
+            raise ConfigError(f"--contact_force_threshold must be >= 0 [N], got {self.contact_force_threshold}")
+        if self.max_pose_age < 0:
+            raise ConfigError(f"--max_pose_age must be >= 0 [s], got {self.max_pose_age}")
+        sim_only = isinstance(self.perception, RenderedPerceptionConfig | TruthPerceptionConfig)
+        if sim_only and not self.robot.simulated:
+            raise ConfigError(
+                f"--perception.type={self.perception.get_choice_name(type(self.perception))} needs the simulated "
+                "arm (--robot.type=sim); a real arm needs --perception.type=realsense"
+            )
+        if self.compare_sim and not self.robot.simulated:
+            raise ConfigError("--compare_sim=true needs --robot.type=sim")
+        if self.realtime is None:
+            self.realtime = not self.robot.simulated
+        if self.prompt is None:
+            self.prompt = not self.robot.simulated
+
+    def real_world_from_base(self) -> np.ndarray:
+        T = np.eye(4)
+        T[:3, 3] = self.world_from_base
+        return T

@@ -1,0 +1,170 @@
+"""Trials of a policy on an arm: build the parts from a :class:`DeployConfig`, run, summarise.
+
+A rehearsal (``--robot.type=sim``) runs trial ``i`` on igen-eval's scene ``i`` with the same pose
+error, so ``--compare_sim=true`` can report the deployment path's success next to the policy's
+own sim success on identical situations: the two should agree within sampling noise.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+from tqdm import tqdm
+
+from igen_lerobot.collect import episode_seed
+from igen_lerobot.evaluation import evaluate, wilson_interval
+from igen_lerobot.policies.source import make_base_policy
+from lerobot_robot_igen.arm import SafeArm
+from lerobot_robot_igen.belief import CubeBelief, check_block_grasp_spec
+from lerobot_robot_igen.config_deploy import (
+    DeployConfig,
+    RealSensePerceptionConfig,
+    RenderedPerceptionConfig,
+    TruthPerceptionConfig,
+)
+from lerobot_robot_igen.deploy_loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
+from lerobot_robot_igen.driver import ArmDriver, ArmState
+from lerobot_robot_igen.pose_source import PoseSource
+
+logger = logging.getLogger(__name__)
+
+
+class GraspLiftJudge:
+    """Success on a real arm: the gripper closed on something cube-sized and lifted it 4 cm.
+
+    (A rehearsal uses the simulator's own success test instead.)
+    """
+
+    def __init__(self, cube_size: float = 0.05, lift: float = 0.04) -> None:
+        self.cube_size, self.lift = cube_size, lift
+        self._grasp_z: float | None = None
+
+    def __call__(self, state: ArmState, action: np.ndarray) -> bool:
+        closed = bool(action[3] > 0.0)
+        holding = closed and 0.6 * self.cube_size <= state.gripper_width <= 1.1 * self.cube_size
+        if not holding:
+            self._grasp_z = None
+            return False
+        z = float(state.T_base_eef[2, 3])
+        if self._grasp_z is None:
+            self._grasp_z = z
+        return z - self._grasp_z >= self.lift
+
+
+def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
+    """The configured cube pose source (sim sources need the simulated arm)."""
+    from lerobot_robot_igen import pose_source
+
+    p = cfg.perception
+    if isinstance(p, TruthPerceptionConfig):
+        return pose_source.SimTruthPose(driver)
+    if isinstance(p, RenderedPerceptionConfig):
+        return pose_source.RenderedICPPose(driver, p.distance, p.azimuth_deg, p.elevation_deg, p.depth_noise_m)
+    if isinstance(p, RealSensePerceptionConfig):
+        from lerobot_robot_igen.perception.camera_model import load_extrinsics
+        from lerobot_robot_igen.realsense import RealSenseConfig, RealSenseRGBD
+
+        T_base_camera = load_extrinsics(p.calibration)
+        camera = RealSenseRGBD(RealSenseConfig(serial=p.serial, recording=p.recording))
+        return pose_source.RealSenseICPPose(camera, T_base_camera)
+    raise TypeError(f"unknown perception config {type(p).__name__}")
+
+
+def _summary(name: str, outcomes: list[EpisodeOutcome]) -> dict:
+    successes = sum(o.success for o in outcomes)
+    merged: dict[str, list[float]] = {}
+    for o in outcomes:
+        for key, stats in o.timing.items():
+            if stats:
+                merged.setdefault(key, []).append(stats["max_ms"])
+    return {
+        "name": name,
+        "trials": len(outcomes),
+        "successes": successes,
+        "success_rate": successes / len(outcomes),
+        "ci95": wilson_interval(successes, len(outcomes)),
+        "faults": [o.fault for o in outcomes if o.fault],
+        "worst_ms": {k: max(v) for k, v in merged.items()},
+    }
+
+
+def deploy(cfg: DeployConfig, on_step=None) -> dict:
+    """Run ``cfg.trials`` episodes; returns (and optionally writes) a JSON-able report."""
+    from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
+
+    env_cfg = BlockGraspEnvConfig()
+    check_block_grasp_spec(env_cfg.task_spec)
+    policy = make_base_policy(cfg.policy, env_cfg)
+    driver = cfg.robot.make_driver()
+    driver.connect()
+    simulated = cfg.robot.simulated
+    world_from_base = driver.world_from_base if driver.world_from_base is not None else cfg.real_world_from_base()
+    arm = SafeArm(driver, world_from_base, cfg.safety)
+    poses = make_pose_source(cfg, driver)
+    settings = LoopSettings(
+        fps=cfg.fps,
+        max_steps=cfg.max_steps,
+        contact_force_threshold=cfg.contact_force_threshold,
+        max_pose_age=cfg.max_pose_age,
+        realtime=bool(cfg.realtime),
+    )
+    outcomes: list[EpisodeOutcome] = []
+    step_times: list[float] = []
+    period_times: list[float] = []
+
+    def record(rec: StepRecord) -> None:
+        step_times.append(rec.seconds.get("step", 0.0))
+        if "period" in rec.seconds:
+            period_times.append(rec.seconds["period"])
+        if on_step is not None:
+            on_step(rec)
+
+    started = time.perf_counter()
+    try:
+        with tqdm(total=cfg.trials, desc=f"deploy {cfg.policy.describe()}", unit="trial") as bar:
+            for i in range(cfg.trials):
+                seed = episode_seed(cfg.seed, i)
+                if simulated:
+                    driver.reset_scene(seed)
+                    offset = driver.env.corruption  # igen-eval's trial i: same scene, same pose error
+                    judge = _sim_judge(driver)
+                else:
+                    if cfg.prompt:
+                        input(f"trial {i + 1}/{cfg.trials}: place the cube, clear the workspace, press Enter ")
+                    driver.move_home()
+                    offset = cfg.corruption.sample(np.random.default_rng(seed))
+                    judge = GraspLiftJudge()
+                outcome = run_episode(arm, poses, policy, CubeBelief(offset, cfg.reveal), settings, judge, record)
+                outcomes.append(outcome)
+                if not simulated:
+                    driver.set_gripper(False)
+                bar.update()
+                bar.set_postfix(success=f"{sum(o.success for o in outcomes)}/{len(outcomes)}")
+    finally:
+        arm.close()
+        poses.close()
+        driver.disconnect()
+    report = {
+        "policy": cfg.policy.describe(),
+        "robot": cfg.robot.get_choice_name(type(cfg.robot)),
+        "perception": cfg.perception.get_choice_name(type(cfg.perception)),
+        "deployment": _summary("deployment", outcomes),
+        "per_trial": [o.to_json() for o in outcomes],
+        "loop": {"step": timing_stats(step_times), "period": timing_stats(period_times)},
+        "seconds": time.perf_counter() - started,
+    }
+    if cfg.compare_sim:
+        env = env_cfg.make_task_env()
+        try:
+            result = evaluate(env, policy, "sim", cfg.trials, cfg.seed, cfg.max_steps)
+        finally:
+            env.close()
+        report["sim"] = {"success_rate": result.success_rate, "ci95": result.ci95, "successes": result.successes}
+        report["per_trial_sim"] = result.per_trial
+    return report
+
+
+def _sim_judge(driver):
+    return lambda state, action: driver.task_success()

@@ -1,0 +1,196 @@
+"""The 20 Hz deployment loop: perceive, believe, act, through the safety layer, with timing stats.
+
+One loop for the real arm and for its rehearsal in simulation. Each period:
+
+1. read the arm (task frame) — a measured pose outside the workspace stops it;
+2. read the cube pose; if perception fails, keep the last estimate for at most
+   ``max_pose_age`` seconds, then stop (stale perception);
+3. contact = external force above ``contact_force_threshold``; the first contact reveals the pose;
+4. build the observation exactly as in training and ask the policy for an action;
+5. send the target through :class:`~lerobot_robot_igen.arm.SafeArm` (limits, watchdog);
+6. let the period pass (simulated arms step; real ones move while the loop sleeps).
+
+Any exception, Ctrl-C included, stops the arm before it propagates; faults end the episode
+with their reason recorded.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from igen_lerobot.agents import Policy
+from igen_lerobot.collect import RatePacer
+from igen_lerobot.exceptions import IgenError
+from lerobot_robot_igen.arm import SafeArm
+from lerobot_robot_igen.belief import CubeBelief, block_grasp_observation
+from lerobot_robot_igen.driver import ArmState, DriverError
+from lerobot_robot_igen.perception.cube_pose import PerceptionError
+from lerobot_robot_igen.pose_source import PoseReading, PoseSource
+from lerobot_robot_igen.safety import SafetyViolationError
+
+logger = logging.getLogger(__name__)
+
+
+class StalePerceptionError(PerceptionError):
+    """No trustworthy cube pose for longer than the loop may act on an old one."""
+
+
+@dataclass
+class LoopSettings:
+    """What the loop needs besides its parts."""
+
+    fps: int = 20
+    max_steps: int = 200
+    contact_force_threshold: float = 2.0  # [N] external force that counts as touching the cube
+    max_pose_age: float = 0.5  # [s] act on a previous cube estimate for at most this long
+    realtime: bool = True  # pace to the wall clock (real arms); False: as fast as the sim steps
+
+
+@dataclass
+class StepRecord:
+    """One period, for timing statistics and for loggers (Rerun)."""
+
+    step: int
+    state: ArmState
+    T_world_eef: np.ndarray
+    T_world_cube: np.ndarray
+    believed_position: np.ndarray
+    observation: dict[str, np.ndarray]
+    action: np.ndarray
+    target: np.ndarray  # sent task-frame target (4x4)
+    contact: bool
+    revealed: bool
+    pose_fresh: bool
+    reading: PoseReading | None
+    seconds: dict[str, float]  # perception, policy, command, step (compute time), period (tick to tick)
+
+
+@dataclass
+class EpisodeOutcome:
+    """How one episode ended."""
+
+    success: bool
+    steps: int
+    fault: str | None = None  # why the arm was stopped, if it was
+    revealed_at: int | None = None
+    timing: dict[str, dict[str, float]] = field(default_factory=dict)
+    perception_failures: int = 0
+    clamped_targets: int = 0
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+def timing_stats(samples: list[float]) -> dict[str, float]:
+    """Median, p95, worst and standard deviation in milliseconds."""
+    if not samples:
+        return {}
+    ms = np.asarray(samples) * 1000.0
+    return {
+        "median_ms": float(np.median(ms)),
+        "p95_ms": float(np.percentile(ms, 95)),
+        "max_ms": float(ms.max()),
+        "std_ms": float(ms.std()),
+    }
+
+
+def run_episode(
+    arm: SafeArm,
+    poses: PoseSource,
+    policy: Policy,
+    belief: CubeBelief,
+    settings: LoopSettings,
+    judge: Callable[[ArmState, np.ndarray], bool],
+    on_step: Callable[[StepRecord], None] | None = None,
+) -> EpisodeOutcome:
+    """Run one episode; the arm is stopped (not disconnected) whatever happens."""
+    period = 1.0 / settings.fps
+    max_stale = settings.max_pose_age
+    pacer = RatePacer(settings.fps if settings.realtime else None)
+    policy.reset()
+    arm.rearm()
+    times: dict[str, list[float]] = {"perception": [], "policy": [], "command": [], "step": [], "period": []}
+    outcome = EpisodeOutcome(success=False, steps=0)
+    T_world_cube: np.ndarray | None = None
+    pose_time = -np.inf  # loop time of the last good estimate
+    last_tick = None
+    try:
+        for step in range(settings.max_steps):
+            pacer.wait()
+            tick = time.perf_counter()
+            if last_tick is not None:
+                times["period"].append(tick - last_tick)
+            last_tick = tick
+            loop_time = step * period  # simulated arms: control periods, not wall time
+            state, T_world_eef = arm.read()
+
+            start = time.perf_counter()
+            reading, fresh = None, False
+            try:
+                reading = poses.read()
+                T_world_cube = arm.T_world_base @ reading.T_base_cube
+                pose_time, fresh = loop_time, True
+            except PerceptionError as err:
+                outcome.perception_failures += 1
+                if T_world_cube is None or loop_time - pose_time > max_stale:
+                    age = "no estimate yet"
+                    if T_world_cube is not None:
+                        age = f"last good one {loop_time - pose_time:.2f} s old"
+                    raise StalePerceptionError(
+                        f"no cube pose ({err}); {age}, more than max_pose_age={max_stale} s"
+                    ) from err
+            times["perception"].append(time.perf_counter() - start)
+
+            belief.update(state.external_force > settings.contact_force_threshold, T_world_eef)
+            if belief.revealed and outcome.revealed_at is None:
+                outcome.revealed_at = step
+            observation = block_grasp_observation(T_world_eef, state.gripper_width, T_world_cube, belief)
+
+            start = time.perf_counter()
+            action = np.asarray(policy.act(observation), dtype=float)
+            times["policy"].append(time.perf_counter() - start)
+
+            start = time.perf_counter()
+            target = arm.command(T_world_eef, action[:3], close_gripper=bool(action[3] > 0.0), period=period)
+            times["command"].append(time.perf_counter() - start)
+            times["step"].append(time.perf_counter() - tick)
+            if on_step is not None:
+                on_step(
+                    StepRecord(
+                        step=step,
+                        state=state,
+                        T_world_eef=T_world_eef,
+                        T_world_cube=T_world_cube,
+                        believed_position=observation["observation.environment_state"][:3].astype(float),
+                        observation=observation,
+                        action=action,
+                        target=target,
+                        contact=belief.contact,
+                        revealed=belief.revealed,
+                        pose_fresh=fresh,
+                        reading=reading,
+                        seconds={k: v[-1] for k, v in times.items() if v},
+                    )
+                )
+            arm.driver.sync(period)
+            outcome.steps = step + 1
+            if judge(state, action):
+                outcome.success = True
+                break
+    except (SafetyViolationError, PerceptionError, DriverError, IgenError) as err:
+        arm.halt(str(err))
+        outcome.fault = arm.fault or str(err)
+        logger.warning("episode stopped at step %d: %s", outcome.steps, outcome.fault)
+    except BaseException as err:  # Ctrl-C, a policy crash: stop the arm first, then let it propagate
+        arm.halt(f"{type(err).__name__}: {err}" if str(err) else type(err).__name__)
+        raise
+    finally:
+        arm.idle()
+        outcome.timing = {name: timing_stats(values) for name, values in times.items()}
+        outcome.clamped_targets = arm.clamped_targets
+    return outcome

@@ -1,0 +1,111 @@
+"""Where the deployment loop gets the cube's pose: a camera + ICP, or the simulator's truth.
+
+Every source returns ``T_base_cube`` in the robot base frame or raises
+:class:`~lerobot_robot_igen.perception.cube_pose.PerceptionError` with the reason; the loop
+decides what a missing estimate means (hold the last one briefly, then stop).
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lerobot_robot_igen.perception.cube_pose import CubePoseConfig, CubePoseEstimate
+
+__all__ = ["PoseSource", "PoseReading", "SimTruthPose", "RenderedICPPose", "RealSenseICPPose"]
+
+
+@dataclass
+class PoseReading:
+    """One estimate and, for cameras, the frame it came from (for logging)."""
+
+    T_base_cube: np.ndarray
+    estimate: CubePoseEstimate | None = None
+    color: np.ndarray | None = None
+    depth: np.ndarray | None = None
+    extras: dict = field(default_factory=dict)
+
+
+class PoseSource(abc.ABC):
+    """A cube pose estimator the loop polls once per control period."""
+
+    @abc.abstractmethod
+    def read(self) -> PoseReading:
+        """The current ``T_base_cube``, or :class:`PerceptionError`."""
+
+    def close(self) -> None:  # noqa: B027 - most sources hold nothing
+        """Release the camera."""
+
+
+class SimTruthPose(PoseSource):
+    """The simulator's true cube pose (rehearsals that isolate the loop from perception)."""
+
+    def __init__(self, arm) -> None:
+        self.arm = arm
+
+    def read(self) -> PoseReading:
+        return PoseReading(T_base_cube=self.arm.true_cube_pose())
+
+
+class RenderedICPPose(PoseSource):
+    """A D415-like camera rendered from the simulated scene, through the real ICP estimator.
+
+    The camera stands on a tripod in front of the table looking down at the cube region, as on
+    the real setup; depth gets the D415's noise and millimetre quantisation.
+    """
+
+    def __init__(
+        self,
+        arm,
+        distance: float = 0.85,
+        azimuth_deg: float = 180.0,
+        elevation_deg: float = -55.0,
+        depth_noise_m: float = 0.001,
+        seed: int = 0,
+        config: CubePoseConfig | None = None,
+    ) -> None:
+        from lerobot_env_igen.rgbd import RGBDCamera
+        from lerobot_robot_igen.perception.camera_model import Intrinsics
+        from lerobot_robot_igen.perception.cube_pose import CubePoseEstimator
+
+        env = arm.env
+        self.camera = RGBDCamera(env.model, env.data)
+        self.camera.look_at((0.0, 0.0, 0.8), distance, azimuth_deg, elevation_deg)
+        _, _, T_world_camera = self.camera.render()
+        T_base_camera = np.linalg.inv(arm.world_from_base) @ T_world_camera
+        width, height = self.camera.width, self.camera.height
+        intrinsics = Intrinsics.from_vertical_fov(width, height, self.camera.fovy_deg)
+        self.estimator = CubePoseEstimator(intrinsics, T_base_camera, config)
+        self.depth_noise_m = depth_noise_m
+        self.rng = np.random.default_rng(seed)
+
+    def read(self) -> PoseReading:
+        rgb, depth, _ = self.camera.render()
+        if self.depth_noise_m > 0:
+            depth = depth + self.rng.normal(0.0, self.depth_noise_m, size=depth.shape).astype(np.float32)
+        depth = (np.round(depth * 1000.0) / 1000.0).astype(np.float32)
+        estimate = self.estimator.estimate(rgb, depth)
+        return PoseReading(T_base_cube=estimate.T_base_cube, estimate=estimate, color=rgb, depth=depth)
+
+    def close(self) -> None:
+        self.camera.close()
+
+
+class RealSenseICPPose(PoseSource):
+    """A RealSense D415 (live or a recording) through the ICP estimator, extrinsics from calibration."""
+
+    def __init__(self, camera, T_base_camera: np.ndarray, config: CubePoseConfig | None = None) -> None:
+        from lerobot_robot_igen.perception.cube_pose import CubePoseEstimator
+
+        self.camera = camera.start() if getattr(camera, "intrinsics", None) is None else camera
+        self.estimator = CubePoseEstimator(self.camera.intrinsics, T_base_camera, config)
+
+    def read(self) -> PoseReading:
+        color, depth, _ = self.camera.read()
+        estimate = self.estimator.estimate(color, depth)
+        return PoseReading(T_base_cube=estimate.T_base_cube, estimate=estimate, color=color, depth=depth)
+
+    def close(self) -> None:
+        self.camera.stop()

@@ -1,0 +1,319 @@
+"""The deployment loop on the simulated arm: observations as in training, sim success preserved,
+and every fault ends in a stopped arm with a clear reason."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from igen_lerobot.collect import episode_seed
+from igen_lerobot.corruption import Reveal
+from igen_lerobot.evaluation import evaluate
+from igen_lerobot.exceptions import ConfigError
+from lerobot_robot_igen.arm import SafeArm
+from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
+from lerobot_robot_igen.belief import CubeBelief
+from lerobot_robot_igen.config_deploy import (
+    DeployConfig,
+    RealSensePerceptionConfig,
+    SimArmBackendConfig,
+    TruthPerceptionConfig,
+)
+from lerobot_robot_igen.deploy import deploy
+from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
+from lerobot_robot_igen.driver import ConnectionLostError
+from lerobot_robot_igen.perception.cube_pose import CubeNotVisibleError
+from lerobot_robot_igen.pose_source import SimTruthPose
+from lerobot_robot_igen.safety import SafetyLimits
+
+SEED = 1_000_003
+
+
+@pytest.fixture
+def sim_arm():
+    arm = MujocoArm()
+    arm.connect()
+    yield arm
+    arm.disconnect()
+
+
+def scripted_policy():
+    from lerobot_env_igen.block_grasp.scripted import ScriptedGraspPolicy
+
+    return ScriptedGraspPolicy()
+
+
+def run(arm, policy, poses=None, settings=None, seed=SEED, limits=None, on_step=None, watchdog=False):
+    arm.reset_scene(seed)
+    safe = SafeArm(arm, arm.world_from_base, limits or SafetyLimits(), watchdog=watchdog)
+    belief = CubeBelief(arm.env.corruption, Reveal.FULL)
+    settings = settings or LoopSettings(realtime=False, contact_force_threshold=0.0)
+    try:
+        outcome = run_episode(
+            safe, poses or SimTruthPose(arm), policy, belief, settings, lambda s, a: arm.task_success(), on_step
+        )
+    finally:
+        safe.close()
+    return outcome, safe
+
+
+def test_observation_is_built_exactly_as_in_training(sim_arm, block_grasp_config):
+    """Same scene, same pose error, same policy: the loop's observations are BlockGraspEnv's."""
+    env = block_grasp_config.make_task_env()
+    env_obs = []
+    policy = scripted_policy()
+    env.reset(SEED)
+    policy.reset()
+    obs = env.observe()
+    for _ in range(60):
+        env_obs.append(obs)
+        env.step(policy.act(obs))
+        obs = env.observe()
+    env.close()
+
+    loop_obs = []
+    outcome, _ = run(
+        sim_arm,
+        scripted_policy(),
+        settings=LoopSettings(realtime=False, max_steps=60, contact_force_threshold=0.0),
+        on_step=lambda rec: loop_obs.append(rec.observation),
+    )
+    assert outcome.fault is None
+    first_contact = next(i for i, o in enumerate(env_obs) if o["observation.environment_state"][7] > 0)
+    assert first_contact > 5
+    for i in range(first_contact):  # identical inputs until the first touch (tolerance: float32 rounding)
+        for key in ("observation.state", "observation.environment_state"):
+            np.testing.assert_allclose(loop_obs[i][key], env_obs[i][key], atol=1e-6, err_msg=f"{key} at step {i}")
+    # contact comes from the force on the hand (as on a real arm), not from geom pairs: same step
+    assert loop_obs[first_contact]["observation.environment_state"][7] == 1.0
+    assert loop_obs[first_contact]["observation.environment_state"][8] == 1.0
+
+
+def test_rehearsal_preserves_the_policys_sim_success(block_grasp_config):
+    """Trial i of the rehearsal is igen-eval's trial i; outcomes agree trial by trial (tolerance: 1 of 6)."""
+    cfg = DeployConfig(robot=SimArmBackendConfig(), perception=TruthPerceptionConfig(), trials=6, compare_sim=True)
+    report = deploy(cfg)
+    deployed = [t["success"] for t in report["per_trial"]]
+    sim = report["per_trial_sim"]
+    assert sum(a != b for a, b in zip(deployed, sim, strict=True)) <= 1, (deployed, sim)
+    assert report["deployment"]["faults"] == []
+    # and the sim side really is igen-eval's rollout on the same seeds
+    env = block_grasp_config.make_task_env()
+    assert evaluate(env, scripted_policy(), "x", 6, SEED, 200, progress=False).per_trial == sim
+    env.close()
+
+
+def test_rendered_camera_and_icp_in_the_loop():
+    """A simulated D415 through the real ICP estimator drives a successful grasp."""
+    from lerobot_robot_igen.config_deploy import RenderedPerceptionConfig
+
+    cfg = DeployConfig(robot=SimArmBackendConfig(), perception=RenderedPerceptionConfig(), trials=1)
+    report = deploy(cfg)
+    trial = report["per_trial"][0]
+    assert trial["success"], trial
+    assert trial["timing"]["perception"]["median_ms"] > 0
+
+
+def test_a_trained_checkpoint_deploys(bc_rnn_checkpoint):
+    """A lerobot-train checkpoint loads with its processors and runs the loop without a fault."""
+    from igen_lerobot.policies.source import PolicySourceConfig
+
+    cfg = DeployConfig(
+        policy=PolicySourceConfig(path=str(bc_rnn_checkpoint)),
+        robot=SimArmBackendConfig(),
+        perception=TruthPerceptionConfig(),
+        trials=1,
+        max_steps=30,
+    )
+    report = deploy(cfg)
+    assert report["per_trial"][0]["steps"] == 30 or report["per_trial"][0]["success"]
+    assert report["policy"] == str(bc_rnn_checkpoint)
+
+
+# ---------------------------------------------------------------------------------------------- faults
+class DropsConnection(MujocoArm):
+    """The simulated arm, losing its connection after ``n`` control periods."""
+
+    def __init__(self, n: int) -> None:
+        super().__init__()
+        self.n, self.stops = n, 0
+
+    def sync(self, period):
+        self.n -= 1
+        if self.n < 0:
+            raise ConnectionLostError("robot at 127.0.0.1 stopped answering (test)")
+        super().sync(period)
+
+    def stop(self):
+        self.stops += 1
+        super().stop()
+
+
+def test_connection_lost_mid_episode_stops_with_the_reason():
+    arm = DropsConnection(20)
+    arm.connect()
+    outcome, safe = run(arm, scripted_policy())
+    arm.disconnect()
+    assert not outcome.success and outcome.steps == 20
+    assert "stopped answering" in outcome.fault
+    assert arm.stops >= 1 and safe.fault
+
+
+class WildPolicy:
+    """Outputs a 0.5 m step: what a checkpoint for another task or unnormalised output looks like."""
+
+    def reset(self):
+        pass
+
+    def act(self, observation):
+        return np.array([0.0, 0.5, 0.0, -1.0])
+
+
+def test_out_of_bounds_action_stops_the_arm_and_refuses_more(sim_arm):
+    outcome, safe = run(sim_arm, WildPolicy())
+    assert outcome.steps == 0 and "refuse_delta" in outcome.fault
+    with pytest.raises(Exception, match="stopped"):
+        safe.command(sim_arm.env.eef_pose(), np.zeros(3), False, 0.05)
+
+
+class Climber:
+    def reset(self):
+        pass
+
+    def act(self, observation):
+        return np.array([0.0, 0.0, 0.03, -1.0])
+
+
+def test_targets_are_clamped_to_the_workspace_and_far_ones_refused(sim_arm):
+    # a ceiling 2 cm above the start: the climb is clamped there, the arm never leaves the box
+    low = (-0.3, -0.4, 0.805)
+    limits = SafetyLimits(workspace_min=low, workspace_max=(0.3, 0.4, 1.02), clamp_margin=0.05)
+    heights = []
+    outcome, safe = run(sim_arm, Climber(), limits=limits, on_step=lambda r: heights.append(r.target[2, 3]))
+    assert outcome.fault is None and safe.clamped_targets > 0
+    assert max(heights) <= 1.02 + 1e-9
+    # a box the arm already stands 10 cm outside of: refused at the first reading
+    limits = SafetyLimits(workspace_min=low, workspace_max=(0.3, 0.4, 0.9), clamp_margin=0.05)
+    outcome, _ = run(sim_arm, Climber(), limits=limits)
+    assert outcome.steps == 0 and "outside the workspace" in outcome.fault
+
+
+class FlakyCamera(SimTruthPose):
+    """Loses sight of the cube after ``good`` frames (the gripper hides it, the camera dies...)."""
+
+    def __init__(self, arm, good: int) -> None:
+        super().__init__(arm)
+        self.good = good
+
+    def read(self):
+        self.good -= 1
+        if self.good < 0:
+            raise CubeNotVisibleError("only 3 red points (need 60): cube out of view or occluded")
+        return super().read()
+
+
+def test_stale_perception_stops_after_max_pose_age(sim_arm):
+    settings = LoopSettings(realtime=False, max_pose_age=0.5, contact_force_threshold=0.0)
+    outcome, _ = run(sim_arm, scripted_policy(), poses=FlakyCamera(sim_arm, 10), settings=settings)
+    # 10 good frames, then 0.5 s (10 periods at 20 Hz) on the last estimate, then a stop
+    assert outcome.steps == 20 and outcome.perception_failures == 11
+    assert "max_pose_age=0.5" in outcome.fault and "out of view" in outcome.fault
+
+
+def test_no_cube_at_the_start_never_moves_the_arm(sim_arm):
+    outcome, _ = run(sim_arm, scripted_policy(), poses=FlakyCamera(sim_arm, 0))
+    assert outcome.steps == 0 and "no estimate yet" in outcome.fault
+
+
+class Interrupted:
+    def __init__(self):
+        self.calls = 0
+
+    def reset(self):
+        pass
+
+    def act(self, observation):
+        self.calls += 1
+        if self.calls == 5:
+            raise KeyboardInterrupt
+        return np.array([0.0, 0.0, -0.01, -1.0])
+
+
+def test_ctrl_c_stops_the_arm_then_propagates():
+    arm = DropsConnection(10_000)
+    arm.connect()
+    with pytest.raises(KeyboardInterrupt):
+        run(arm, Interrupted())
+    assert arm.stops >= 1
+    arm.disconnect()
+
+
+class WallClockArm(DropsConnection):
+    """The simulated arm on the host's clock: a hung loop is stale in wall time, as on a real arm."""
+
+    def clock(self):
+        return time.monotonic()
+
+
+def test_watchdog_stops_an_arm_whose_loop_hangs():
+    arm = WallClockArm(10_000)
+    arm.connect()
+    arm.reset_scene(SEED)
+    safe = SafeArm(arm, arm.world_from_base, SafetyLimits(watchdog_timeout=0.1))
+    try:
+        safe.command(arm.env.eef_pose(), np.array([0.0, 0.0, -0.01]), False, 0.05)
+        time.sleep(0.2)  # no command: the loop "hangs"
+        deadline = time.monotonic() + 2.0
+        while safe.fault is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert safe.fault is not None and "watchdog" in safe.fault
+        assert arm.stops >= 1
+    finally:
+        safe.close()
+        arm.disconnect()
+
+
+def test_config_errors_name_the_field():
+    from lerobot_robot_igen.config_deploy import ArmBackendConfig
+
+    @ArmBackendConfig.register_subclass("test_real")
+    class RealLike(ArmBackendConfig):
+        def make_driver(self):
+            raise AssertionError
+
+    with pytest.raises(ConfigError, match="perception.type=realsense"):
+        DeployConfig(robot=RealLike(), perception=TruthPerceptionConfig())
+    with pytest.raises(ConfigError, match="perception.calibration"):
+        RealSensePerceptionConfig(serial="123")
+    with pytest.raises(ConfigError, match="compare_sim"):
+        DeployConfig(robot=RealLike(), perception=RealSensePerceptionConfig(calibration="c.json"), compare_sim=True)
+    with pytest.raises(ConfigError, match="trials"):
+        DeployConfig(trials=0)
+
+
+def test_camera_not_found_and_missing_calibration_are_clear(tmp_path):
+    from lerobot_robot_igen.deploy import make_pose_source
+    from lerobot_robot_igen.perception.camera_model import save_extrinsics
+    from lerobot_robot_igen.realsense import CameraError
+
+    missing = DeployConfig(perception=RealSensePerceptionConfig(calibration=str(tmp_path / "none.json")))
+    with pytest.raises(ConfigError, match="none.json"):
+        make_pose_source(missing, None)
+    save_extrinsics(tmp_path / "calib.json", np.eye(4))
+    absent = DeployConfig(
+        perception=RealSensePerceptionConfig(serial="000000000000", calibration=str(tmp_path / "calib.json"))
+    )
+    with pytest.raises(CameraError, match="000000000000"):
+        make_pose_source(absent, None)
+
+
+def test_trial_seeds_are_igen_evals(sim_arm, block_grasp_config):
+    env = block_grasp_config.make_task_env()
+    for i in range(3):
+        env.reset(episode_seed(SEED, i))
+        sim_arm.reset_scene(episode_seed(SEED, i))
+        np.testing.assert_array_equal(env.corruption, sim_arm.env.corruption)
+        np.testing.assert_allclose(env.true_object_poses()["cube"], sim_arm.env.true_object_poses()["cube"], atol=1e-12)
+    env.close()
