@@ -276,7 +276,7 @@ def test_watchdog_stops_an_arm_whose_loop_hangs():
 
 
 def test_config_errors_name_the_field():
-    from lerobot_robot_igen.config_deploy import ArmBackendConfig
+    from lerobot_robot_igen.config_arm import ArmBackendConfig
 
     @ArmBackendConfig.register_subclass("test_real")
     class RealLike(ArmBackendConfig):

@@ -3,3 +3,7 @@
 LeRobot imports this package on every ``lerobot-*`` command, so it stays light: hardware
 libraries (franky, pyrealsense2, Open3D) load only where a backend is built.
 """
+
+from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
+
+__all__ = ["IgenFrankaConfig"]

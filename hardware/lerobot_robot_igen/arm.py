@@ -45,6 +45,7 @@ class SafeArm:
         self.max_delta = float(max_delta)
         self.refuse_delta = float(refuse_delta)
         self.fault: str | None = None
+        self.fault_recoverable = False  # only a watchdog stop: the arm stood still, nothing was violated
         self.clamped_targets = 0
         self._gripper_closed: bool | None = None
         self._last_command = float("inf")  # armed by the first command of an episode
@@ -108,11 +109,13 @@ class SafeArm:
             self._last_command = self.driver.clock()
         return target
 
-    def halt(self, reason: str) -> None:
+    def halt(self, reason: str, recoverable: bool = False) -> None:
         """Stop the arm for a fault; commands are refused until :meth:`rearm`."""
         if self.fault is None:
-            logger.error("stopping the arm: %s", reason)
+            log = logger.warning if recoverable else logger.error
+            log("stopping the arm: %s", reason)
             self.fault = reason
+            self.fault_recoverable = recoverable
         self._stop_driver()
 
     def _stop_driver(self) -> None:
@@ -126,6 +129,7 @@ class SafeArm:
         """Accept commands again after a fault (a new episode); recovers the driver's error state."""
         self.driver.recover()
         self.fault = None
+        self.fault_recoverable = False
         self._gripper_closed = None
         self.clamped_targets = 0
         self._last_command = float("inf")
@@ -139,7 +143,7 @@ class SafeArm:
         timeout = self.guard.limits.watchdog_timeout
         while not self._watchdog_stop.wait(min(0.02, timeout / 4)):
             if self.fault is None and self.driver.clock() - self._last_command > timeout:
-                self.halt(f"watchdog: no command for more than {timeout} s")
+                self.halt(f"watchdog: no command for more than {timeout} s", recoverable=True)
 
     def close(self) -> None:
         """Stop the watchdog and the arm (not the connection: the driver's owner closes it)."""

@@ -1,0 +1,48 @@
+"""Which arm drives the loop (``--robot.type`` of igen-deploy, ``--robot.arm.type`` of the LeRobot robot).
+
+Kept apart from the deployment config so that LeRobot, which imports this plugin on every
+``lerobot-*`` command, loads nothing heavy: a backend's libraries load in ``make_driver``.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import draccus
+
+from lerobot_robot_igen.driver import ArmDriver
+
+# Where a real, table-mounted arm's base sits in the task frame: the table top is z = 0.8 m in
+# training, and the cube region is centred 0.56 m in front of the base, as in the simulator.
+REAL_WORLD_FROM_BASE_XYZ = (-0.56, 0.0, 0.8)
+
+
+@dataclass
+class ArmBackendConfig(draccus.ChoiceRegistry, abc.ABC):
+    """Which arm the loop drives."""
+
+    @property
+    def simulated(self) -> bool:
+        return False
+
+    @abc.abstractmethod
+    def make_driver(self) -> ArmDriver:
+        """The (not yet connected) driver."""
+
+
+@ArmBackendConfig.register_subclass("sim")
+@dataclass
+class SimArmBackendConfig(ArmBackendConfig):
+    """The Block Grasp scene in MuJoCo (rehearsal)."""
+
+    fps: int = 20
+
+    @property
+    def simulated(self) -> bool:
+        return True
+
+    def make_driver(self) -> ArmDriver:
+        from lerobot_robot_igen.backends.mujoco_arm import MujocoArm, MujocoArmConfig
+
+        return MujocoArm(MujocoArmConfig(fps=self.fps))

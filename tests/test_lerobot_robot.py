@@ -1,0 +1,191 @@
+"""Our arm as a LeRobot Robot: LeRobot finds it, lerobot-replay and lerobot-rollout drive it (simulated
+arm here; the franky backend is driven against franky-sim in test_franky_backend.py)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lerobot_robot_igen.safety import SafetyViolationError
+
+BIN = Path(sys.executable).parent
+FPS = 20
+
+
+def make_robot(**overrides):
+    from lerobot.robots.utils import make_robot_from_config
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
+
+    register_third_party_plugins()
+    return make_robot_from_config(IgenFrankaConfig(**overrides))
+
+
+def test_lerobot_finds_the_robot_from_its_type_name():
+    from lerobot.robots.config import RobotConfig
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    config_cls = RobotConfig.get_choice_class("igen_franka")
+    robot = make_robot()
+    assert type(robot).__name__ == "IgenFranka" and isinstance(robot.config, config_cls)
+    assert set(robot.action_features) == {"ee.x.pos", "ee.y.pos", "ee.z.pos", "gripper.pos"}
+    # every scalar is a *.pos: what lerobot-rollout routes to the policy
+    assert all(k.endswith(".pos") for k in robot.observation_features)
+
+
+def test_targets_are_approached_not_jumped_to_and_bad_keys_refused():
+    robot = make_robot(max_step=0.02, max_target_distance=0.3)
+    robot.connect()
+    try:
+        obs = robot.get_observation()
+        assert set(obs) == set(robot.observation_features)
+        start = np.array([obs["ee.x.pos"], obs["ee.y.pos"], obs["ee.z.pos"]])
+        goal = start + np.array([0.0, 0.12, -0.05])
+        action = {"ee.x.pos": goal[0], "ee.y.pos": goal[1], "ee.z.pos": goal[2], "gripper.pos": 0.08}
+        sent = []
+        for _ in range(40):
+            reply = robot.send_action(action)
+            sent.append(np.array([reply[k] for k in ("ee.x.pos", "ee.y.pos", "ee.z.pos")]))
+        # each sent target is at most max_step per axis from the hand, never the far goal at once
+        assert np.max(np.abs(sent[0] - start)) <= 0.02 + 1e-9
+        obs = robot.get_observation()
+        reached = np.array([obs["ee.x.pos"], obs["ee.y.pos"], obs["ee.z.pos"]])
+        assert np.linalg.norm(reached - goal) < 0.01  # tolerance: 1 cm after 2 s
+        # lerobot-rollout's tear-down sends every *.pos of the observation: orientation keys are ignored
+        robot.send_action({**obs, "gripper.pos": 0.08})
+        with pytest.raises(ValueError, match=r"missing \['gripper.pos'\], unknown \['shoulder.pos'\]"):
+            robot.send_action({"ee.x.pos": 0.0, "ee.y.pos": 0.0, "ee.z.pos": 1.0, "shoulder.pos": 0.1})
+        far = {**action, "ee.z.pos": reached[2] + 0.5}
+        with pytest.raises(SafetyViolationError, match="max_target_distance|refuse_delta|outside"):
+            robot.send_action(far)
+        assert robot.arm.fault is not None  # stopped, and it stays stopped
+        with pytest.raises(SafetyViolationError, match="stopped"):
+            robot.send_action(action)
+    finally:
+        robot.disconnect()
+    assert not robot.is_connected
+
+
+def record_dataset(root: Path, repo_id: str) -> list[np.ndarray]:
+    """Drive the simulated robot along a square with LeRobot's dataset API; returns the measured path."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+    from lerobot.utils.feature_utils import build_dataset_frame, hw_to_dataset_features
+
+    robot = make_robot()
+    features = {
+        **hw_to_dataset_features(robot.action_features, "action", use_video=False),
+        **hw_to_dataset_features(robot.observation_features, "observation", use_video=False),
+    }
+    dataset = LeRobotDataset.create(repo_id, FPS, root=root, robot_type=robot.name, features=features, use_videos=False)
+    robot.connect()
+    path = []
+    try:
+        for episode in range(2):
+            obs = robot.get_observation()
+            corner = np.array([obs["ee.x.pos"], obs["ee.y.pos"], obs["ee.z.pos"]])
+            for step in range(60):
+                leg = step // 15
+                offset = [(0.01, 0, 0), (0, 0.01, 0), (-0.01, 0, 0), (0, -0.01, 0)][leg]
+                corner = corner + np.array(offset) * 0.5
+                action = {"ee.x.pos": corner[0], "ee.y.pos": corner[1], "ee.z.pos": corner[2], "gripper.pos": 0.08}
+                obs = robot.get_observation()
+                if episode == 0:
+                    path.append(np.array([obs["ee.x.pos"], obs["ee.y.pos"], obs["ee.z.pos"]]))
+                frame = {
+                    **build_dataset_frame(dataset.features, obs, prefix="observation"),
+                    **build_dataset_frame(dataset.features, action, prefix="action"),
+                    "task": "trace a square",
+                }
+                dataset.add_frame(frame)
+                robot.send_action(action)
+            dataset.save_episode()
+    finally:
+        robot.disconnect()
+        dataset.finalize()
+    return path
+
+
+def run(command: list[str], log: Path) -> None:
+    result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
+    log.write_text(result.stdout + result.stderr)
+    assert result.returncode == 0, f"{command[0]} failed:\n{(result.stdout + result.stderr)[-3000:]}"
+
+
+@pytest.fixture(scope="module")
+def square_dataset(tmp_path_factory):
+    root = tmp_path_factory.mktemp("robot_data") / "square"
+    return root, "local/igen_franka_square", record_dataset(root, "local/igen_franka_square")
+
+
+def test_lerobot_replay_drives_the_robot_along_a_recorded_episode(square_dataset, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    root, repo_id, recorded_path = square_dataset
+    assert LeRobotDataset(repo_id, root=root).num_episodes == 2
+    trace = tmp_path / "replay.jsonl"
+    run(
+        [
+            str(BIN / "lerobot-replay"),
+            "--robot.type=igen_franka",
+            "--robot.arm.type=sim",
+            f"--robot.trace={trace}",
+            f"--dataset.repo_id={repo_id}",
+            f"--dataset.root={root}",
+            "--dataset.episode=0",
+            f"--dataset.fps={FPS}",
+            "--play_sounds=false",
+        ],
+        tmp_path / "replay.log",
+    )
+    lines = [json.loads(line) for line in trace.read_text().splitlines()]
+    assert len(lines) == 60
+    recorded = LeRobotDataset(repo_id, root=root, episodes=[0])
+    actions = np.stack([recorded[i]["action"].numpy() for i in range(60)])
+    # the robot received the dataset's actions and moved as it did when they were recorded
+    # (same scene, same physics: tolerance 2 mm; the hand lags a moving target by ~1.5 cm either way)
+    np.testing.assert_allclose([list(line["received"].values())[:3] for line in lines], actions[:, :3], atol=1e-6)
+    measured = np.array([line["measured"] for line in lines])
+    np.testing.assert_allclose(measured[:-1], np.array(recorded_path[1:]), atol=0.002)
+
+
+def test_lerobot_rollout_runs_a_policy_and_returns_home_smoothly(square_dataset, tmp_path):
+    from igen_lerobot.training import TrainConfig, lerobot_train
+
+    root, repo_id, _ = square_dataset
+    checkpoint = lerobot_train(
+        TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0), root, repo_id, tmp_path / "train"
+    )
+    trace = tmp_path / "rollout.jsonl"
+    run(
+        [
+            str(BIN / "lerobot-rollout"),
+            "--strategy.type=base",
+            f"--policy.path={checkpoint}",
+            "--robot.type=igen_franka",
+            "--robot.arm.type=sim",
+            f"--robot.trace={trace}",
+            f"--fps={FPS}",
+            "--duration=2",
+            "--task=trace a square",
+            "--play_sounds=false",
+        ],
+        tmp_path / "rollout.log",
+    )
+    lines = [json.loads(line) for line in trace.read_text().splitlines()]
+    policy_steps = [line for line in lines if "ee.qw.pos" not in line["received"]]
+    teardown = [line for line in lines if "ee.qw.pos" in line["received"]]
+    assert len(policy_steps) >= 10, "the policy drove the robot"
+    assert len(teardown) >= 100, "lerobot-rollout returned the robot to its initial position (3 s at 50 Hz)"
+    # the tear-down's targets move smoothly: no step larger than max_step (3 cm)
+    sent = np.array([line["sent"] for line in lines])
+    assert np.max(np.abs(np.diff(sent, axis=0))) <= 0.03 + 0.01
+    # and it ends where it started (tolerance: 1 cm)
+    initial = np.array([teardown[-1]["received"][k] for k in ("ee.x.pos", "ee.y.pos", "ee.z.pos")])
+    assert np.linalg.norm(np.array(teardown[-1]["measured"]) - initial) < 0.01
