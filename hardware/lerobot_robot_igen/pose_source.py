@@ -31,6 +31,8 @@ class PoseReading:
 class PoseSource(abc.ABC):
     """A cube pose estimator the loop polls once per control period."""
 
+    last_frame: tuple[np.ndarray, np.ndarray] | None = None  # (color, depth) of the last read, even a failed one
+
     @abc.abstractmethod
     def read(self) -> PoseReading:
         """The current ``T_base_cube``, or :class:`PerceptionError`."""
@@ -86,6 +88,7 @@ class RenderedICPPose(PoseSource):
         if self.depth_noise_m > 0:
             depth = depth + self.rng.normal(0.0, self.depth_noise_m, size=depth.shape).astype(np.float32)
         depth = (np.round(depth * 1000.0) / 1000.0).astype(np.float32)
+        self.last_frame = (rgb, depth)
         estimate = self.estimator.estimate(rgb, depth)
         return PoseReading(T_base_cube=estimate.T_base_cube, estimate=estimate, color=rgb, depth=depth)
 
@@ -99,11 +102,12 @@ class RealSenseICPPose(PoseSource):
     def __init__(self, camera, T_base_camera: np.ndarray, config: CubePoseConfig | None = None) -> None:
         from lerobot_robot_igen.perception.cube_pose import CubePoseEstimator
 
-        self.camera = camera.start() if getattr(camera, "intrinsics", None) is None else camera
+        self.camera = camera.start()  # idempotent: a started camera is returned as is
         self.estimator = CubePoseEstimator(self.camera.intrinsics, T_base_camera, config)
 
     def read(self) -> PoseReading:
         color, depth, _ = self.camera.read()
+        self.last_frame = (color, depth)
         estimate = self.estimator.estimate(color, depth)
         return PoseReading(T_base_cube=estimate.T_base_cube, estimate=estimate, color=color, depth=depth)
 
