@@ -189,3 +189,89 @@ def test_lerobot_rollout_runs_a_policy_and_returns_home_smoothly(square_dataset,
     # and it ends where it started (tolerance: 1 cm)
     initial = np.array([teardown[-1]["received"][k] for k in ("ee.x.pos", "ee.y.pos", "ee.z.pos")])
     assert np.linalg.norm(np.array(teardown[-1]["measured"]) - initial) < 0.01
+
+
+@pytest.fixture()
+def x_display():
+    import os
+    import shutil
+    import time
+
+    if shutil.which("Xvfb") is None or shutil.which("xdotool") is None:
+        pytest.fail("Xvfb and xdotool are missing: run scripts/setup.sh (it installs them)")
+    number = 80 + os.getpid() % 9
+    proc = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+    socket = Path(f"/tmp/.X11-unix/X{number}")
+    deadline = time.time() + 10
+    while not socket.exists() and time.time() < deadline:
+        time.sleep(0.05)
+    assert socket.exists(), "Xvfb did not start"
+    yield f":{number}"
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_path):
+    """A person holds Down then right Shift on LeRobot's keyboard (real X events through Xvfb) while lerobot-record runs."""
+    import os
+    import time
+
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    root, repo_id = tmp_path / "teleop", "local/igen_franka_teleop"
+    env = {**os.environ, "DISPLAY": x_display, "PYTHONUNBUFFERED": "1"}
+    command = [
+        str(BIN / "lerobot-record"),
+        "--robot.type=igen_franka",
+        "--robot.arm.type=sim",
+        "--teleop.type=igen_ee_target",
+        "--teleop.device=keyboard_ee",
+        f"--dataset.repo_id={repo_id}",
+        f"--dataset.root={root}",
+        "--dataset.single_task=move the hand",
+        "--dataset.num_episodes=1",
+        "--dataset.episode_time_s=6",
+        "--dataset.reset_time_s=0",
+        f"--dataset.fps={FPS}",
+        "--dataset.video=false",
+        "--dataset.push_to_hub=false",
+        "--play_sounds=false",
+    ]
+    proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines = []
+    try:
+        for line in proc.stdout:  # wait until the episode is being recorded
+            lines.append(line)
+            if "Recording episode" in line:
+                break
+        time.sleep(1.0)
+
+        def key(action, name):
+            subprocess.run(["xdotool", action, name], check=True, env=env)
+
+        key("keydown", "Down")  # keyboard_ee: Down is delta_y = +1
+        time.sleep(1.5)
+        key("keyup", "Down")
+        # (Left/Right are lerobot-record's own re-record / end-episode keys: not used here)
+        key("keydown", "Shift_R")  # right shift is delta_z = +1
+        time.sleep(1.0)
+        key("keyup", "Shift_R")
+        out, _ = proc.communicate(timeout=300)
+        lines.append(out)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, "".join(lines)[-3000:]
+    dataset = LeRobotDataset(repo_id, root=root)
+    assert dataset.num_episodes == 1 and dataset.num_frames >= 0.8 * 6 * FPS
+    names = dataset.features["action"]["names"]
+    assert names == ["ee.x.pos", "ee.y.pos", "ee.z.pos", "gripper.pos"]
+    actions = np.stack([dataset[i]["action"].numpy() for i in range(dataset.num_frames)])
+    state = np.stack([dataset[i]["observation.state"].numpy() for i in range(dataset.num_frames)])
+    # targets start at home and move +y (about 1.5 s x 0.1 m/s), then +z (1 s), x untouched
+    np.testing.assert_allclose(actions[0, :3], (-0.05, 0.0, 1.0), atol=1e-6)
+    dy, dz = actions[-1, 1] - actions[0, 1], actions[-1, 2] - actions[0, 2]
+    assert 0.08 <= dy <= 0.22 and 0.04 <= dz <= 0.16, (dy, dz)
+    assert np.all(np.diff(actions[:, 1]) >= -1e-9) and abs(actions[-1, 0] + 0.05) < 1e-6
+    # and the robot followed its targets (tolerance 2 cm: the hand lags a moving target)
+    assert np.linalg.norm(state[-1, :3] - actions[-1, :3]) < 0.02

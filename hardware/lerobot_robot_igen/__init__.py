@@ -4,6 +4,7 @@ LeRobot imports this package on every ``lerobot-*`` command, so it stays light: 
 libraries (franky, pyrealsense2, Open3D) load only where a backend is built.
 """
 
+from lerobot_robot_igen.config_end_effector_target import EndEffectorTargetConfig
 from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
 
-__all__ = ["IgenFrankaConfig"]
+__all__ = ["EndEffectorTargetConfig", "IgenFrankaConfig"]

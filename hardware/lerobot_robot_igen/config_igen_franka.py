@@ -13,6 +13,7 @@ from lerobot.robots.config import RobotConfig
 
 from igen_lerobot.exceptions import ConfigError
 from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
+from lerobot_robot_igen.config_end_effector_target import HOME_TARGET
 from lerobot_robot_igen.safety import SafetyLimits
 
 
@@ -32,6 +33,8 @@ class IgenFrankaConfig(RobotConfig):
     max_step: float = 0.03  # [m] per action: a far target is approached at this step (and the speed limit)
     max_target_distance: float = 0.3  # [m] a target further than this from the hand is refused (the arm stops)
     grasp_below_width: float = 0.04  # [m] a gripper.pos target below this closes the gripper, else it opens
+    home_on_connect: bool = True  # move to `home` when connecting (where igen_ee_target's targets start)
+    home: tuple[float, float, float] = HOME_TARGET  # [m] task frame
     trace: str | None = None  # JSON-lines file: every action received, sent and the measured pose after it
 
     def __post_init__(self) -> None:

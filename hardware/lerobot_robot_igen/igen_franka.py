@@ -99,6 +99,8 @@ class IgenFranka(Robot):
         self.cameras = make_cameras_from_configs(self.config.cameras)
         for camera in self.cameras.values():
             camera.connect()
+        if self.config.home_on_connect:
+            self.go_home()
         if self.config.trace:
             Path(self.config.trace).parent.mkdir(parents=True, exist_ok=True)
             self._trace = open(self.config.trace, "a")  # noqa: SIM115 - lives as long as the connection
@@ -117,6 +119,23 @@ class IgenFranka(Robot):
         if self._trace is not None:
             self._trace.close()
             self._trace = None
+
+    def go_home(self, tolerance: float = 0.005, max_periods: int = 200) -> None:
+        """Move the hand to ``config.home`` through the safety layer, gripper open."""
+        import time
+
+        period = 1.0 / self.config.fps
+        home = np.asarray(self.config.home, dtype=float)
+        self.driver.move_home()  # the backend's own (joint-space) home first, then the exact target
+        for _ in range(max_periods):
+            _, T_world_eef = self.arm.read()
+            if np.linalg.norm(T_world_eef[:3, 3] - home) < tolerance:
+                break
+            self.arm.command(T_world_eef, home - T_world_eef[:3, 3], close_gripper=False, period=period)
+            self.driver.sync(period)
+            if not self.config.arm.simulated:
+                time.sleep(period)
+        self.arm.idle()
 
     # ------------------------------------------------------------------ io
     def _require_connected(self) -> None:
