@@ -49,4 +49,6 @@ python=$(find_python) || { echo "setup: Python 3.12 not found; install it or set
 
 export UV_PYTHON_DOWNLOADS=never
 uv sync --locked --all-packages --all-extras --python "$python" --quiet
+# franky-sim (the FR3 simulator the franky backend is tested against) needs mujoco 4: its own env.
+uv sync --locked --project tools/franky_sim --python "$python" --quiet
 echo "setup: environment ready in .venv ($("$python" --version), $(uv --version))"

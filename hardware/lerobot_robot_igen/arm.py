@@ -59,7 +59,11 @@ class SafeArm:
     # ------------------------------------------------------------------ state
     def read(self) -> tuple[ArmState, np.ndarray]:
         """The arm state and ``T_world_eef``; a measured pose outside the workspace is a fault."""
-        state = self.driver.read_state()
+        try:
+            state = self.driver.read_state()
+        except DriverError as err:
+            self.halt(str(err))
+            raise
         T_world_eef = self.T_world_base @ state.T_base_eef
         try:
             self.guard.check_position(T_world_eef[:3, 3])
@@ -101,17 +105,22 @@ class SafeArm:
             self.clamped_targets += 1
         target = np.array(T_world_eef, dtype=float)
         target[:3, 3] = target_pos
-        with self._lock:
-            self.driver.send_target(self.world_to_base(target))
-            if close_gripper != self._gripper_closed:
-                self.driver.set_gripper(close_gripper)
-                self._gripper_closed = close_gripper
-            self._last_command = self.driver.clock()
+        try:
+            with self._lock:
+                self.driver.send_target(self.world_to_base(target))
+                if close_gripper != self._gripper_closed:
+                    self.driver.set_gripper(close_gripper)
+                    self._gripper_closed = close_gripper
+                self._last_command = self.driver.clock()
+        except DriverError as err:
+            self.halt(str(err))
+            raise
         return target
 
     def halt(self, reason: str, recoverable: bool = False) -> None:
         """Stop the arm for a fault; commands are refused until :meth:`rearm`."""
-        if self.fault is None:
+        # a hard fault replaces a watchdog stop: it is the reason the user needs to see
+        if self.fault is None or (self.fault_recoverable and not recoverable):
             log = logger.warning if recoverable else logger.error
             log("stopping the arm: %s", reason)
             self.fault = reason

@@ -74,6 +74,7 @@ class CubePoseEstimate:
     rmse: float  # [m]
     num_points: int
     seconds: float
+    points: np.ndarray | None = None  # (N, 3) the segmented cube points in the base frame (for logging)
 
     @property
     def position(self) -> np.ndarray:
@@ -263,4 +264,5 @@ class CubePoseEstimator:
             rmse=float(result.inlier_rmse),
             num_points=len(points),
             seconds=time.perf_counter() - start,
+            points=points,
         )

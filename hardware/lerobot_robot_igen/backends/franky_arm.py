@@ -1,0 +1,203 @@
+"""A real Franka (FR3 or Panda) through franky-control, behind the driver protocol.
+
+How the 20 Hz stream reaches the arm: every period the loop sends an *absolute* Cartesian
+target as an asynchronous ``CartesianMotion``; franky replaces the running motion and its
+online trajectory generator (Ruckig) plans a jerk-limited path to the new target within the
+arm's limits scaled by ``relative_dynamics_factor``. Absolute, because franky's *relative*
+Cartesian motions are expressed in the end-effector frame, not the base frame the loop uses.
+
+Dynamics we ship: velocity factor 0.3, acceleration and jerk factors 0.05. A stream of
+targets that changes every 50 ms is exactly what trips the arm's discontinuity reflexes when
+the planner may use high accelerations and jerks (seen at factors >= 0.15 with franka-sim's
+motion-limit checks; <= 0.05 ran clean); velocity does not cause them, and capping it at 30%
+(about 0.5 m/s, the safety layer's speed limit) keeps the arm as fast as the policy was in
+simulation. The safety layer already limits each target's step, which is the filtering the
+stream needs; no extra smoothing is added (it would add lag the policy never saw).
+
+Frames: franky reports the flange-mounted hand's TCP (``end_effector_pose``) in the base frame;
+the policy's end-effector frame is robosuite's grip site, the same point rotated 90 degrees
+about the approach axis (``tcp_to_site_rotation``). Never import franky and pylibfranka in
+one process: both bundle libfranka.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from lerobot_robot_igen.config_arm import ArmBackendConfig
+from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError, DriverError
+
+logger = logging.getLogger(__name__)
+
+# R_site = R_tcp @ TCP_TO_SITE: franky's top-down hand (x forward, fingers along base y) is the
+# policy's grip site (x along base y, y along base x, z down).
+TCP_TO_SITE = ((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+TOP_DOWN_TCP = ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, -1.0))
+
+
+@ArmBackendConfig.register_subclass("franky")
+@dataclass
+class FrankyArmConfig(ArmBackendConfig):
+    """A Franka FR3/Panda over FCI (``--robot.host``), with its gripper."""
+
+    host: str = "172.16.0.2"
+    velocity_factor: float = 0.3  # of the arm's limits, for the streamed motions (see module docstring)
+    acceleration_factor: float = 0.05
+    jerk_factor: float = 0.05
+    home_position: tuple[float, float, float] = (0.51, 0.0, 0.2)  # [m] base frame, hand top-down
+    home_factor: float = 0.2  # dynamics of the (blocking) move home
+    grasp_width: float = 0.05  # [m] the 5 cm cube
+    grasp_tolerance: float = 0.04  # [m] epsilon in/out of the grasp: succeed on anything roughly cube-sized
+    grasp_force: float = 20.0  # [N]
+    gripper_speed: float = 0.1  # [m/s]
+    open_width: float = 0.08  # [m]
+    tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
+
+    def make_driver(self) -> ArmDriver:
+        return FrankyArm(self)
+
+
+class FrankyArm(ArmDriver):
+    """The franky-control backend."""
+
+    def __init__(self, config: FrankyArmConfig) -> None:
+        self.config = config
+        self.robot = None
+        self.gripper = None
+        self._franky = None
+        self._gripper_closed: bool | None = None
+        self._pending = None  # the last gripper future
+        self._T_tcp_site = np.eye(4)
+        self._T_tcp_site[:3, :3] = np.asarray(config.tcp_to_site_rotation, dtype=float)
+        self._T_site_tcp = np.linalg.inv(self._T_tcp_site)
+
+    # ------------------------------------------------------------------ errors
+    def _fail(self, what: str, error: Exception) -> DriverError:
+        franky = self._franky
+        text = f"{type(error).__name__}: {error}"
+        network = franky is not None and isinstance(error, franky.NetworkException)
+        # libfranka also reports a dead link from the state stream as a bare "Net Exception" / TCP / UDP error
+        if network or any(word in str(error) for word in ("Net Exception", "TCP", "UDP", "Connection")):
+            return ConnectionLostError(
+                f"robot at {self.config.host} unreachable while {what} ({text}); check the network cable, that "
+                "the arm is unlocked with FCI enabled in Desk, and that no other program holds control"
+            )
+        return DriverError(f"the robot refused {what}: {text} (a reflex? recover() clears it)")
+
+    def _call(self, what: str, fn, *args, **kwargs):
+        if self.robot is None:
+            raise ConnectionLostError(f"not connected to the robot at {self.config.host}: call connect() first")
+        try:
+            return fn(*args, **kwargs)
+        except Exception as error:  # franky raises its own exception types; map them to ours
+            if isinstance(error, DriverError):
+                raise
+            raise self._fail(what, error) from error
+
+    # ------------------------------------------------------------------ connection
+    def connect(self) -> None:
+        import franky
+
+        self._franky = franky
+        cfg = self.config
+        try:
+            robot = franky.Robot(cfg.host, realtime_config=franky.RealtimeConfig.Ignore)
+            gripper = franky.Gripper(cfg.host)
+        except Exception as error:
+            raise ConnectionLostError(
+                f"cannot connect to the robot at {cfg.host} ({error}); check the address (--robot.host), the "
+                "network cable, and that FCI is enabled in Desk"
+            ) from error
+        self.robot, self.gripper = robot, gripper
+        self._call("error recovery", robot.recover_from_errors)
+        robot.relative_dynamics_factor = franky.RelativeDynamicsFactor(
+            cfg.velocity_factor, cfg.acceleration_factor, cfg.jerk_factor
+        )
+        self._gripper_closed = None
+
+    def disconnect(self) -> None:
+        if self.robot is not None:
+            try:
+                self.stop()
+            except DriverError as error:  # a reflex: the arm is already stopped
+                logger.warning("stopping before disconnect failed: %s", error)
+        self.robot = self.gripper = None
+
+    @property
+    def is_connected(self) -> bool:
+        return self.robot is not None
+
+    # ------------------------------------------------------------------ state
+    def read_state(self) -> ArmState:
+        robot = self.robot
+        pose = self._call("a state read", lambda: robot.current_cartesian_state.pose.end_effector_pose)
+        joints = self._call("a state read", lambda: np.asarray(robot.current_joint_positions, dtype=float))
+        force = self._call("a state read", lambda: np.asarray(robot.state.O_F_ext_hat_K, dtype=float)[:3])
+        width = self._call("a gripper read", lambda: float(self.gripper.width))
+        return ArmState(
+            T_base_eef=np.asarray(pose.matrix, dtype=float) @ self._T_tcp_site,
+            joint_positions=joints,
+            gripper_width=width,
+            external_force=float(np.linalg.norm(force)),
+            timestamp=time.monotonic(),
+        )
+
+    # ------------------------------------------------------------------ commands
+    def _motion(self, T_base_site: np.ndarray, factor=None):
+        franky = self._franky
+        T_base_tcp = np.asarray(T_base_site, dtype=float) @ self._T_site_tcp
+        target = franky.Affine(np.ascontiguousarray(T_base_tcp))
+        if factor is None:
+            return franky.CartesianMotion(target, franky.ReferenceType.Absolute)
+        return franky.CartesianMotion(target, franky.ReferenceType.Absolute, relative_dynamics_factor=factor)
+
+    def send_target(self, T_base_eef: np.ndarray) -> None:
+        motion = self._motion(T_base_eef)
+        self._call("a Cartesian target", self.robot.move, motion, asynchronous=True)
+
+    def set_gripper(self, closed: bool) -> None:
+        cfg = self.config
+        if closed == self._gripper_closed:
+            return
+        if closed:
+            self._pending = self._call(
+                "a grasp",
+                self.gripper.grasp_async,
+                cfg.grasp_width,
+                cfg.gripper_speed,
+                cfg.grasp_force,
+                cfg.grasp_tolerance,
+                cfg.grasp_tolerance,
+            )
+        else:
+            self._pending = self._call(
+                "opening the gripper", self.gripper.move_async, cfg.open_width, cfg.gripper_speed
+            )
+        self._gripper_closed = closed
+
+    def stop(self) -> None:
+        if self.robot is None:
+            return
+        try:
+            self._call("a stop", self.robot.stop)
+        except ConnectionLostError as error:
+            # The arm's controller stops by itself when the stream of commands breaks off
+            # (libfranka's communication constraints); nothing more can be sent to it.
+            logger.warning("cannot send stop: %s; the arm halts on its own when it loses the connection", error)
+
+    def recover(self) -> None:
+        self._call("error recovery", self.robot.recover_from_errors)
+
+    def move_home(self) -> None:
+        cfg = self.config
+        T_home = np.eye(4)
+        T_home[:3, :3] = np.asarray(TOP_DOWN_TCP) @ self._T_tcp_site[:3, :3]  # the site's top-down pose
+        T_home[:3, 3] = cfg.home_position
+        self._call("the move home", self.robot.move, self._motion(T_home, cfg.home_factor))
+        self.set_gripper(False)
+        if self._pending is not None:
+            self._call("opening the gripper", self._pending.wait, 5.0)
