@@ -49,7 +49,7 @@ class FrankyArmConfig(ArmBackendConfig):
     acceleration_factor: float = 0.05
     jerk_factor: float = 0.05
     home_position: tuple[float, float, float] = (0.51, 0.0, 0.2)  # [m] base frame, hand top-down
-    home_factor: float = 0.2  # dynamics of the (blocking) move home
+    home_velocity_factor: float = 0.2  # the (blocking) move home; acceleration and jerk as above
     grasp_width: float = 0.05  # [m] the 5 cm cube
     grasp_tolerance: float = 0.04  # [m] epsilon in/out of the grasp: succeed on anything roughly cube-sized
     grasp_force: float = 20.0  # [N]
@@ -197,7 +197,8 @@ class FrankyArm(ArmDriver):
         T_home = np.eye(4)
         T_home[:3, :3] = np.asarray(TOP_DOWN_TCP) @ self._T_tcp_site[:3, :3]  # the site's top-down pose
         T_home[:3, 3] = cfg.home_position
-        self._call("the move home", self.robot.move, self._motion(T_home, cfg.home_factor))
+        factor = self._franky.RelativeDynamicsFactor(cfg.home_velocity_factor, cfg.acceleration_factor, cfg.jerk_factor)
+        self._call("the move home", self.robot.move, self._motion(T_home, factor))
         self.set_gripper(False)
         if self._pending is not None:
             self._call("opening the gripper", self._pending.wait, 5.0)
