@@ -11,6 +11,7 @@ from lerobot.teleoperators.config import TeleoperatorConfig
 from igen_lerobot.env_config import TaskEnvConfig
 from igen_lerobot.exceptions import ConfigError
 from igen_lerobot.policies.source import PolicySourceConfig
+from igen_lerobot.viz.rerun_log import RerunConfig
 
 MODES = ("demos", "interventions")
 OPERATORS = ("scripted", "teleop")
@@ -51,6 +52,7 @@ class CollectConfig:
     teleop_gate: str = "auto"  # "motion" (held keys), "events" (device intervention button), "auto"
     policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # the base policy the operator corrects
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
+    rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log each episode
 
     def __post_init__(self) -> None:
         if self.env is None:

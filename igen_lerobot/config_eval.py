@@ -9,6 +9,7 @@ from lerobot.envs.configs import EnvConfig
 from igen_lerobot.env_config import resolve_task_env
 from igen_lerobot.exceptions import ConfigError
 from igen_lerobot.policies.source import PolicySourceConfig
+from igen_lerobot.viz.rerun_log import RerunConfig
 
 EVAL_SEED = 1_000_003  # far from the seeds collection and generation use by default
 
@@ -25,6 +26,7 @@ class EvalConfig:
     n_trials: int = 50
     seed: int = EVAL_SEED
     output: str | None = None  # JSON file for the results
+    rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log each trial
 
     def __post_init__(self) -> None:
         self.env = resolve_task_env(self.task, self.env)

@@ -14,6 +14,7 @@ from igen_lerobot.generation.job import GenerationMode
 from igen_lerobot.generation.mimicgen import MimicGenConfig
 from igen_lerobot.generation.runner import BACKENDS
 from igen_lerobot.policies.source import PolicySourceConfig
+from igen_lerobot.viz.rerun_log import RerunConfig
 
 
 @dataclass
@@ -46,6 +47,7 @@ class GenerateConfig:
     igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
     merge_with: str | None = None  # root of a base dataset to aggregate the generated episodes with
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
+    rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log kept episodes
 
     def __post_init__(self) -> None:
         modes = tuple(m.value for m in GenerationMode)

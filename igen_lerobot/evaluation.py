@@ -12,6 +12,7 @@ import logging
 import math
 import re
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -66,9 +67,16 @@ def rollout(env: TaskEnv, policy: Policy, seed: int, max_steps: int) -> tuple[bo
 
 
 def evaluate(
-    env: TaskEnv, policy: Policy, name: str, trials: int, seed: int, max_steps: int, progress: bool = True
+    env: TaskEnv,
+    policy: Policy,
+    name: str,
+    trials: int,
+    seed: int,
+    max_steps: int,
+    progress: bool = True,
+    on_trial: Callable[[int, bool, int], None] | None = None,
 ) -> EvalResult:
-    """Roll ``policy`` out for ``trials`` seeded trials."""
+    """Roll ``policy`` out for ``trials`` seeded trials; ``on_trial(i, success, steps)`` after each."""
     if trials < 1:
         raise ConfigError(f"eval trials must be >= 1, got {trials}")
     start = time.perf_counter()
@@ -78,6 +86,8 @@ def evaluate(
             success, n = rollout(env, policy, episode_seed(seed, i), max_steps)
             outcomes.append(success)
             steps.append(n)
+            if on_trial is not None:
+                on_trial(i, success, n)
             bar.update()
             bar.set_postfix(success=f"{sum(outcomes)}/{len(outcomes)}")
     successes = sum(outcomes)

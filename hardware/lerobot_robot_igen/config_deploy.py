@@ -17,6 +17,7 @@ from igen_lerobot.config_eval import EVAL_SEED
 from igen_lerobot.corruption import BoxNoise, PoseNoise, Reveal
 from igen_lerobot.exceptions import ConfigError
 from igen_lerobot.policies.source import PolicySourceConfig
+from igen_lerobot.viz.rerun_log import RerunConfig
 from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
 from lerobot_robot_igen.safety import SafetyLimits
 
@@ -85,6 +86,7 @@ class DeployConfig:
     compare_sim: bool = False  # rehearsal: also run igen-eval's rollout on the same trials and report both
     prompt: bool | None = None  # None: ask before each real trial (place the cube), never in a rehearsal
     output: str | None = None  # JSON file for the results
+    rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log every step
 
     def __post_init__(self) -> None:
         if self.trials < 1:

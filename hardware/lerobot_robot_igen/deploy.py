@@ -16,6 +16,7 @@ from tqdm import tqdm
 from igen_lerobot.collect import episode_seed
 from igen_lerobot.evaluation import evaluate, wilson_interval
 from igen_lerobot.policies.source import make_base_policy
+from igen_lerobot.viz.rerun_log import EpisodeLogger
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.belief import CubeBelief, check_block_grasp_spec
 from lerobot_robot_igen.config_deploy import (
@@ -114,7 +115,12 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
     step_times: list[float] = []
     period_times: list[float] = []
 
+    viz = EpisodeLogger.open(cfg.rerun, env_cfg.task_spec, "deploy")
+    viz_step = deploy_logger(viz, arm) if viz is not None else None
+
     def record(rec: StepRecord) -> None:
+        if viz_step is not None:
+            viz_step(rec)
         step_times.append(rec.seconds.get("step", 0.0))
         if "period" in rec.seconds:
             period_times.append(rec.seconds["period"])
@@ -146,6 +152,8 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         arm.close()
         poses.close()
         driver.disconnect()
+        if viz is not None:
+            viz.close()
     report = {
         "policy": cfg.policy.describe(),
         "robot": cfg.robot.get_choice_name(type(cfg.robot)),
@@ -164,6 +172,37 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         report["sim"] = {"success_rate": result.success_rate, "ci95": result.ci95, "successes": result.successes}
         report["per_trial_sim"] = result.per_trial
     return report
+
+
+def deploy_logger(viz: EpisodeLogger, arm: SafeArm):
+    """The Rerun hook of the loop: each period's poses, camera frames, cloud and ICP change (task frame)."""
+    state = {"step": 0, "previous": None}
+
+    def log(rec: StepRecord) -> None:
+        reading = rec.reading
+        perceived = rec.T_world_cube[:3, 3] if rec.pose_fresh else None
+        cloud = None
+        if reading is not None and reading.estimate is not None and reading.estimate.points is not None:
+            points = reading.estimate.points
+            cloud = points @ arm.T_world_base[:3, :3].T + arm.T_world_base[:3, 3]
+        viz.log_deploy_step(
+            state["step"],
+            measured_eef=rec.T_world_eef[:3, 3],
+            commanded_eef=rec.target[:3, 3],
+            believed_cube=rec.believed_position,
+            perceived_cube=perceived,
+            previous_cube=state["previous"],
+            color=None if reading is None else reading.color,
+            depth=None if reading is None else reading.depth,
+            cloud=cloud,
+            contact=rec.contact,
+            timing_ms={k: 1000 * v for k, v in rec.seconds.items()},
+        )
+        if perceived is not None:
+            state["previous"] = perceived
+        state["step"] += 1
+
+    return log
 
 
 def _sim_judge(driver):

@@ -30,6 +30,7 @@ from igen_lerobot.dataset.writer import DatasetBuilder
 from igen_lerobot.env_config import TaskEnvConfig
 from igen_lerobot.policies.source import make_base_policy
 from igen_lerobot.scripts.cli import run_cli
+from igen_lerobot.viz.rerun_log import EpisodeLogger
 
 logger = logging.getLogger(__name__)
 
@@ -64,6 +65,7 @@ def collect(cfg: CollectConfig) -> None:
     operator = make_operator(cfg, env_cfg)
     policy = make_base_policy(cfg.policy, env_cfg) if cfg.mode == "interventions" else None
     rate = spec.fps if cfg.operator == "teleop" else None
+    viz = EpisodeLogger.open(cfg.rerun, spec, f"collect/{cfg.mode}")
     try:
         attempt = 0
         with tqdm(total=cfg.num_episodes, initial=kept, desc=f"collecting {cfg.mode}", unit="ep") as bar:
@@ -89,6 +91,8 @@ def collect(cfg: CollectConfig) -> None:
                         if not episode.is_intervention.any()
                         else None
                     )
+                if viz is not None:
+                    viz.log_episode_object(attempt, episode)
                 if reject is None:
                     spool.keep(attempt, episode)
                     kept += 1
@@ -100,6 +104,8 @@ def collect(cfg: CollectConfig) -> None:
     finally:
         operator.close()
         env.close()
+        if viz is not None:
+            viz.close()
     summary = builder.finalize(
         cfg.num_episodes,
         metadata={

@@ -24,6 +24,7 @@ from igen_lerobot.corruption import PoseNoise
 from igen_lerobot.evaluation import EvalResult, best_result, evaluate, list_checkpoints
 from igen_lerobot.policies.source import PolicySourceConfig, make_base_policy
 from igen_lerobot.scripts.cli import run_cli
+from igen_lerobot.viz.rerun_log import EpisodeLogger
 
 logger = logging.getLogger(__name__)
 
@@ -50,15 +51,27 @@ def run_eval(cfg: EvalConfig) -> dict:
         targets = [(None, cfg.policy)]
     env = env_cfg.make_task_env()
     results = []
+    viz = EpisodeLogger.open(cfg.rerun, env_cfg.task_spec, "eval")
     try:
         for step, source in targets:
             policy = make_base_policy(source, env_cfg)
-            result = evaluate(env, policy, source.describe(), cfg.n_trials, cfg.seed, env_cfg.episode_length)
+            on_trial = None
+            if viz is not None:
+                tag = f"step {step}" if step is not None else source.describe()
+
+                def on_trial(i, success, n, tag=tag):
+                    viz.log_outcome(i, success, f"{tag}, {n} steps")
+
+            result = evaluate(
+                env, policy, source.describe(), cfg.n_trials, cfg.seed, env_cfg.episode_length, on_trial=on_trial
+            )
             result.step = step
             results.append(result)
             print(_line(result))
     finally:
         env.close()
+        if viz is not None:
+            viz.close()
     best = best_result(results)
     report = {
         "task": env_cfg.type,

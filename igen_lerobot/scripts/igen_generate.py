@@ -36,12 +36,38 @@ from igen_lerobot.corruption import NoNoise
 from igen_lerobot.dataset.merge import merge_datasets
 from igen_lerobot.dataset.reader import load_episodes
 from igen_lerobot.dataset.writer import DatasetBuilder
+from igen_lerobot.episode import Episode
+from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.job import GenerationJob, GenerationMode
 from igen_lerobot.generation.runner import run_generation
 from igen_lerobot.generation.sources import parse_demos, parse_interventions
 from igen_lerobot.scripts.cli import run_cli
+from igen_lerobot.viz.rerun_log import EpisodeLogger
 
 logger = logging.getLogger(__name__)
+
+
+def live_logger(viz: EpisodeLogger, spool, sources: list[Episode]):
+    """Log each attempt as it finishes.
+
+    Kept episodes go whole (read back from the spool the worker wrote), with the source
+    recoveries they replayed; dropped attempts as an outcome line.
+    """
+
+    def on_result(attempt: int, result: Attempt) -> None:
+        if not result.kept:
+            viz.log_outcome(attempt, False, result.reason or "")
+            return
+        episode = result.episode if result.episode is not None else spool.load(attempt)
+        used = result.details.get("recoveries") or episode.extra.get("recoveries") or []
+        paths = {
+            int(k): sources[int(k)].state[sources[int(k)].is_intervention, :3]
+            for k in used
+            if 0 <= int(k) < len(sources)
+        }
+        viz.log_episode_object(attempt, episode, source_paths=paths)
+
+    return on_result
 
 
 def generate(cfg: GenerateConfig) -> None:
@@ -78,15 +104,21 @@ def generate(cfg: GenerateConfig) -> None:
         mimicgen=cfg.mimicgen,
         igen=cfg.igen,
     )
-    stats = run_generation(
-        job,
-        builder.spool,
-        cfg.num_episodes,
-        workers=cfg.workers,
-        backend=cfg.backend,
-        max_attempts=cfg.max_attempts or None,
-        ray_address=cfg.ray_address,
-    )
+    viz = EpisodeLogger.open(cfg.rerun, spec, f"generate/{mode.value}")
+    try:
+        stats = run_generation(
+            job,
+            builder.spool,
+            cfg.num_episodes,
+            workers=cfg.workers,
+            backend=cfg.backend,
+            max_attempts=cfg.max_attempts or None,
+            ray_address=cfg.ray_address,
+            on_result=None if viz is None else live_logger(viz, builder.spool, episodes),
+        )
+    finally:
+        if viz is not None:
+            viz.close()
     print(stats.summary())
     kept = len(builder.spool.kept_attempts())
     if kept < cfg.num_episodes:

@@ -1,0 +1,237 @@
+"""Episodes and deployment steps into a Rerun recording (a live viewer or an ``.rrd`` file).
+
+Layout (entity paths), one subtree per episode so episodes can be shown side by side or alone:
+
+* ``episodes/<i>/path``: the whole end-effector path, one point per frame coloured by phase
+  (:mod:`igen_lerobot.viz.phases`), with a legend per phase in ``episodes/<i>/legend``;
+* ``episodes/<i>/eef``: the end effector on the ``frame`` timeline;
+* ``episodes/<i>/<object>/believed`` and ``.../true``: the object pose the robot believed and the
+  true one (boxes) on the ``frame`` timeline;
+* ``episodes/<i>/action/<name>`` and ``episodes/<i>/gripper``: scalar plots;
+* ``episodes/<i>/events``: first contact, takeover, end of episode (success or failure).
+
+Episodes are sent as columns (``send_columns``): one call per entity, not one per frame, which
+is what keeps a 1000-episode replay to minutes. Deployment steps are logged one at a time under
+``deploy/`` on the ``step`` timeline.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.task import TaskSpec
+from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_phases, phase_colors
+
+logger = logging.getLogger(__name__)
+
+MODES = ("none", "save", "spawn")
+FRAME = "frame"
+STEP = "step"
+
+
+@dataclass
+class RerunConfig:
+    """``--rerun.mode=save --rerun.path=out.rrd`` streams to a file, ``spawn`` opens a viewer; ``none``: off."""
+
+    mode: str = "none"
+    path: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ConfigError(f"--rerun.mode must be one of {MODES}, got {self.mode!r}")
+        if self.mode == "save" and not self.path:
+            raise ConfigError("--rerun.mode=save needs --rerun.path=<file>.rrd")
+
+    @property
+    def enabled(self) -> bool:
+        return self.mode != "none"
+
+
+def open_recording(cfg: RerunConfig, name: str):
+    """A ``rerun.RecordingStream`` writing where ``cfg`` says, or None when logging is off."""
+    if not cfg.enabled:
+        return None
+    import rerun as rr
+
+    stream = rr.RecordingStream(f"igen_lerobot/{name}")
+    if cfg.mode == "save":
+        Path(cfg.path).parent.mkdir(parents=True, exist_ok=True)
+        stream.save(cfg.path)
+    else:
+        stream.spawn()
+    return stream
+
+
+class EpisodeLogger:
+    """Writes episodes (and deployment steps) of one task to a recording stream."""
+
+    def __init__(self, stream, spec: TaskSpec, object_half_size: float = 0.025) -> None:
+        import rerun as rr
+
+        self.rr = rr
+        self.stream = stream
+        self.spec = spec
+        self.half = object_half_size
+        self.episodes = 0
+
+    @classmethod
+    def open(cls, cfg: RerunConfig, spec: TaskSpec, name: str) -> EpisodeLogger | None:
+        stream = open_recording(cfg, name)
+        return None if stream is None else cls(stream, spec)
+
+    # ------------------------------------------------------------------ episodes
+    def log_episode(
+        self,
+        index: int,
+        state: np.ndarray,
+        env_state: np.ndarray,
+        action: np.ndarray,
+        source: np.ndarray,
+        flagged: np.ndarray,
+        true_object_pose: np.ndarray,
+        success: bool,
+        kind: str = "",
+        source_paths: dict[int, np.ndarray] | None = None,
+    ) -> None:
+        """One whole episode (arrays as in the dataset schema), sent column-wise on the ``frame`` timeline."""
+        rr, stream = self.rr, self.stream
+        root = f"episodes/{index}"
+        n = len(state)
+        frames = rr.TimeColumn(FRAME, sequence=np.arange(n))
+        phases = frame_phases(source, flagged, env_state)
+        eef = np.asarray(state, dtype=np.float32)[:, :3]
+        stream.log(f"{root}/path", rr.Points3D(eef, colors=phase_colors(phases), radii=0.002), static=True)
+        stream.log(
+            f"{root}/info",
+            rr.TextDocument(
+                f"episode {index} ({kind}): {'success' if success else 'failure'}, {n} frames, "
+                f"{int(np.count_nonzero(flagged))} flagged"
+            ),
+            static=True,
+        )
+        for phase in np.unique(phases):
+            label = PHASE_LABELS[Phase(int(phase))]
+            count = int(np.count_nonzero(phases == phase))
+            stream.log(
+                f"{root}/legend/{label.replace(' ', '_')}",
+                rr.TextDocument(f"{label}: {count} frames, colour {PHASE_COLORS[Phase(int(phase))]}"),
+                static=True,
+            )
+        stream.send_columns(
+            f"{root}/eef",
+            indexes=[frames],
+            columns=rr.Points3D.columns(positions=eef, colors=phase_colors(phases), radii=np.full(n, 0.008)),
+        )
+        for k, obj in enumerate(self.spec.objects):
+            believed = np.asarray(env_state, dtype=np.float32)[:, 7 * k : 7 * k + 3]
+            true = np.asarray(true_object_pose, dtype=np.float32)[:, 7 * k : 7 * k + 3]
+            half = np.full((n, 3), self.half, dtype=np.float32)
+            for name, centers, color in (("believed", believed, (219, 68, 55)), ("true", true, (15, 157, 88))):
+                stream.send_columns(
+                    f"{root}/{obj}/{name}",
+                    indexes=[frames],
+                    columns=rr.Boxes3D.columns(centers=centers, half_sizes=half, colors=np.tile(color, (n, 1))),
+                )
+        for j, name in enumerate(self.spec.action_names):
+            stream.send_columns(
+                f"{root}/action/{name}", indexes=[frames], columns=rr.Scalars.columns(scalars=action[:, j])
+            )
+        stream.send_columns(
+            f"{root}/gripper", indexes=[frames], columns=rr.Scalars.columns(scalars=np.asarray(state)[:, -1])
+        )
+        self._events(root, phases, env_state, success, n)
+        for source_index, path in (source_paths or {}).items():
+            stream.log(
+                f"sources/{source_index}/recovery",
+                rr.LineStrips3D([np.asarray(path, dtype=np.float32)], colors=[(15, 157, 88)]),
+                static=True,
+            )
+        self.episodes += 1
+
+    def _events(self, root: str, phases: np.ndarray, env_state: np.ndarray, success: bool, n: int) -> None:
+        rr, stream = self.rr, self.stream
+        events: list[tuple[int, str]] = []
+        revealed = np.flatnonzero(np.asarray(env_state)[:, -1] > 0.5)
+        if len(revealed):
+            events.append((int(revealed[0]), "first contact: the true pose is revealed"))
+        recovery = np.flatnonzero(np.isin(phases, [Phase.OPERATOR, Phase.GENERATED, Phase.INTERPOLATION]))
+        if len(recovery):
+            events.append((int(recovery[0]), "takeover: recovery starts"))
+        events.append((n - 1, "end: success" if success else "end: failure"))
+        events.sort()
+        stream.send_columns(
+            f"{root}/events",
+            indexes=[rr.TimeColumn(FRAME, sequence=[t for t, _ in events])],
+            columns=rr.TextLog.columns(text=[text for _, text in events]),
+        )
+
+    def log_episode_object(self, index: int, episode, source_paths: dict[int, np.ndarray] | None = None) -> None:
+        """:meth:`log_episode` for an :class:`~igen_lerobot.episode.Episode`."""
+        self.log_episode(
+            index,
+            episode.state,
+            episode.env_state,
+            episode.action,
+            episode.source,
+            episode.is_intervention,
+            episode.true_object_pose,
+            episode.success,
+            kind=episode.kind,
+            source_paths=source_paths,
+        )
+
+    def log_outcome(self, index: int, success: bool, reason: str = "") -> None:
+        """An attempt or trial that left no episode (dropped by the generator, or an evaluation trial)."""
+        text = f"{index}: {'success' if success else 'failure'}{f' ({reason})' if reason else ''}"
+        self.stream.log("outcomes", self.rr.TextLog(text, level="INFO" if success else "WARN"))
+
+    # ------------------------------------------------------------------ deployment
+    def log_deploy_step(
+        self,
+        step: int,
+        measured_eef: np.ndarray,
+        commanded_eef: np.ndarray,
+        believed_cube: np.ndarray,
+        perceived_cube: np.ndarray | None = None,
+        previous_cube: np.ndarray | None = None,
+        color: np.ndarray | None = None,
+        depth: np.ndarray | None = None,
+        cloud: np.ndarray | None = None,
+        contact: bool = False,
+        timing_ms: dict[str, float] | None = None,
+    ) -> None:
+        """One deployment period (task frame).
+
+        Commanded vs measured end effector, believed vs perceived cube, the camera images, the
+        segmented cloud, and how far the ICP estimate moved from the previous one.
+        """
+        rr, stream = self.rr, self.stream
+        stream.set_time(STEP, sequence=step)
+        stream.log("deploy/eef/measured", rr.Points3D([measured_eef], colors=[(66, 133, 244)], radii=0.008))
+        stream.log("deploy/eef/commanded", rr.Points3D([commanded_eef], colors=[(255, 140, 0)], radii=0.006))
+        half = [(self.half,) * 3]
+        stream.log("deploy/cube/believed", rr.Boxes3D(centers=[believed_cube], half_sizes=half, colors=[(219, 68, 55)]))
+        if perceived_cube is not None:
+            stream.log(
+                "deploy/cube/perceived", rr.Boxes3D(centers=[perceived_cube], half_sizes=half, colors=[(15, 157, 88)])
+            )
+            if previous_cube is not None:
+                change_mm = 1000 * np.linalg.norm(perceived_cube - previous_cube)
+                stream.log("deploy/cube/icp_change_mm", rr.Scalars(change_mm))
+        if color is not None:
+            stream.log("deploy/camera/color", rr.Image(color))
+        if depth is not None:
+            stream.log("deploy/camera/depth", rr.DepthImage(depth, meter=1.0))
+        if cloud is not None and len(cloud):
+            stream.log("deploy/cube/cloud", rr.Points3D(cloud, colors=[(255, 0, 0)], radii=0.001))
+        stream.log("deploy/contact", rr.Scalars(float(contact)))
+        for name, value in (timing_ms or {}).items():
+            stream.log(f"deploy/timing_ms/{name}", rr.Scalars(value))
+
+    def close(self) -> None:
+        self.stream.flush()
