@@ -20,8 +20,10 @@ from tqdm import tqdm
 
 from igen_lerobot.agents import Policy
 from igen_lerobot.collect import episode_seed
+from igen_lerobot.episode import Episode
 from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.task import TaskEnv
+from igen_lerobot.recorder import EpisodeRecorder
+from igen_lerobot.task import FrameSource, TaskEnv
 
 logger = logging.getLogger(__name__)
 
@@ -55,12 +57,17 @@ class EvalResult:
         return asdict(self)
 
 
-def rollout(env: TaskEnv, policy: Policy, seed: int, max_steps: int) -> tuple[bool, int]:
-    """One closed-loop episode; success ends it early, as in ``lerobot-eval``."""
+def rollout(
+    env: TaskEnv, policy: Policy, seed: int, max_steps: int, recorder: EpisodeRecorder | None = None
+) -> tuple[bool, int]:
+    """One closed-loop episode; success ends it early, as in ``lerobot-eval``. ``recorder`` keeps the frames."""
     obs = env.reset(seed)
     policy.reset()
     for step in range(1, max_steps + 1):
-        if env.step(policy.act(obs)).success:
+        action = policy.act(obs)
+        if recorder is not None:
+            recorder.record(obs, action, FrameSource.POLICY, flagged=False)
+        if env.step(action).success:
             return True, step
         obs = env.observe()
     return False, max_steps
@@ -74,20 +81,28 @@ def evaluate(
     seed: int,
     max_steps: int,
     progress: bool = True,
-    on_trial: Callable[[int, bool, int], None] | None = None,
+    on_trial: Callable[[int, bool, int, Episode | None], None] | None = None,
+    record_trials: bool = False,
 ) -> EvalResult:
-    """Roll ``policy`` out for ``trials`` seeded trials; ``on_trial(i, success, steps)`` after each."""
+    """Roll ``policy`` out for ``trials`` seeded trials.
+
+    ``on_trial(i, success, steps, episode)`` runs after each; ``episode`` holds the trial's frames
+    when ``record_trials`` (for live views), else None.
+    """
     if trials < 1:
         raise ConfigError(f"eval trials must be >= 1, got {trials}")
     start = time.perf_counter()
     outcomes, steps = [], []
     with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
         for i in range(trials):
-            success, n = rollout(env, policy, episode_seed(seed, i), max_steps)
+            recorder = EpisodeRecorder(env) if record_trials else None
+            trial_seed = episode_seed(seed, i)
+            success, n = rollout(env, policy, trial_seed, max_steps, recorder)
             outcomes.append(success)
             steps.append(n)
             if on_trial is not None:
-                on_trial(i, success, n)
+                episode = recorder.episode("evaluation", trial_seed, success) if recorder is not None else None
+                on_trial(i, success, n, episode)
             bar.update()
             bar.set_postfix(success=f"{sum(outcomes)}/{len(outcomes)}")
     successes = sum(outcomes)

@@ -112,6 +112,21 @@ def record_dataset(root: Path, repo_id: str) -> list[np.ndarray]:
     return path
 
 
+def replay_command(root: Path, repo_id: str, trace: Path, *arm: str) -> list[str]:
+    """lerobot-replay of episode 0 on igen_franka with the given ``--robot.arm.*`` arguments."""
+    return [
+        str(BIN / "lerobot-replay"),
+        "--robot.type=igen_franka",
+        *arm,
+        f"--robot.trace={trace}",
+        f"--dataset.repo_id={repo_id}",
+        f"--dataset.root={root}",
+        "--dataset.episode=0",
+        f"--dataset.fps={FPS}",
+        "--play_sounds=false",
+    ]
+
+
 def run(command: list[str], log: Path) -> None:
     result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
     log.write_text(result.stdout + result.stderr)
@@ -130,20 +145,7 @@ def test_lerobot_replay_drives_the_robot_along_a_recorded_episode(square_dataset
     root, repo_id, recorded_path = square_dataset
     assert LeRobotDataset(repo_id, root=root).num_episodes == 2
     trace = tmp_path / "replay.jsonl"
-    run(
-        [
-            str(BIN / "lerobot-replay"),
-            "--robot.type=igen_franka",
-            "--robot.arm.type=sim",
-            f"--robot.trace={trace}",
-            f"--dataset.repo_id={repo_id}",
-            f"--dataset.root={root}",
-            "--dataset.episode=0",
-            f"--dataset.fps={FPS}",
-            "--play_sounds=false",
-        ],
-        tmp_path / "replay.log",
-    )
+    run(replay_command(root, repo_id, trace, "--robot.arm.type=sim"), tmp_path / "replay.log")
     lines = [json.loads(line) for line in trace.read_text().splitlines()]
     assert len(lines) == 60
     recorded = LeRobotDataset(repo_id, root=root, episodes=[0])
@@ -189,26 +191,6 @@ def test_lerobot_rollout_runs_a_policy_and_returns_home_smoothly(square_dataset,
     # and it ends where it started (tolerance: 1 cm)
     initial = np.array([teardown[-1]["received"][k] for k in ("ee.x.pos", "ee.y.pos", "ee.z.pos")])
     assert np.linalg.norm(np.array(teardown[-1]["measured"]) - initial) < 0.01
-
-
-@pytest.fixture()
-def x_display():
-    import os
-    import shutil
-    import time
-
-    if shutil.which("Xvfb") is None or shutil.which("xdotool") is None:
-        pytest.fail("Xvfb and xdotool are missing: run scripts/setup.sh (it installs them)")
-    number = 80 + os.getpid() % 9
-    proc = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "640x480x24", "-nolisten", "tcp"])
-    socket = Path(f"/tmp/.X11-unix/X{number}")
-    deadline = time.time() + 10
-    while not socket.exists() and time.time() < deadline:
-        time.sleep(0.05)
-    assert socket.exists(), "Xvfb did not start"
-    yield f":{number}"
-    proc.terminate()
-    proc.wait(timeout=10)
 
 
 def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_path):
@@ -285,21 +267,8 @@ def test_lerobot_replay_drives_franky_sim_through_the_franky_backend(square_data
     root, repo_id, _ = square_dataset
     trace = tmp_path / "replay_franky.jsonl"
     with franky_sim(cube=None) as server:
-        run(
-            [
-                str(BIN / "lerobot-replay"),
-                "--robot.type=igen_franka",
-                "--robot.arm.type=franky",
-                f"--robot.arm.host={server.host}",
-                f"--robot.trace={trace}",
-                f"--dataset.repo_id={repo_id}",
-                f"--dataset.root={root}",
-                "--dataset.episode=0",
-                f"--dataset.fps={FPS}",
-                "--play_sounds=false",
-            ],
-            tmp_path / "replay_franky.log",
-        )
+        arm = ("--robot.arm.type=franky", f"--robot.arm.host={server.host}")
+        run(replay_command(root, repo_id, trace, *arm), tmp_path / "replay_franky.log")
     lines = [json.loads(line) for line in trace.read_text().splitlines()]
     recorded = LeRobotDataset(repo_id, root=root, episodes=[0])
     actions = np.stack([recorded[i]["action"].numpy() for i in range(len(lines))])

@@ -7,14 +7,10 @@ from step 8 to step 20 of an episode in which the base policy is acting.
 
 import json
 import os
-import shutil
 import subprocess
 import sys
-import time
-from pathlib import Path
 
 import numpy as np
-import pytest
 
 SESSION = r"""
 import json, os, subprocess, time
@@ -58,26 +54,6 @@ person.close()
 print(json.dumps({"flags": episode.is_intervention.tolist(), "source": episode.source.tolist(),
                   "action": episode.action.tolist(), "eef_y": episode.state[:, 1].tolist()}))
 """
-
-
-@pytest.fixture()
-def x_display():
-    if shutil.which("Xvfb") is None or shutil.which("xdotool") is None:
-        pytest.fail("Xvfb and xdotool are missing: run scripts/setup.sh (it installs them)")
-    number = 90 + os.getpid() % 9
-    proc = subprocess.Popen(
-        ["Xvfb", f":{number}", "-screen", "0", "640x480x24", "-nolisten", "tcp"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    socket = Path(f"/tmp/.X11-unix/X{number}")
-    deadline = time.time() + 10
-    while not socket.exists() and time.time() < deadline:
-        time.sleep(0.05)
-    assert socket.exists(), "Xvfb did not start"
-    yield f":{number}"
-    proc.terminate()
-    proc.wait(timeout=10)
 
 
 def test_holding_a_key_takes_over_and_releasing_hands_back(x_display):

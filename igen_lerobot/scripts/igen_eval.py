@@ -59,11 +59,19 @@ def run_eval(cfg: EvalConfig) -> dict:
             if viz is not None:
                 tag = f"step {step}" if step is not None else source.describe()
 
-                def on_trial(i, success, n, tag=tag):
+                def on_trial(i, success, n, episode, tag=tag):
                     viz.log_outcome(i, success, f"{tag}, {n} steps")
+                    viz.log_episode_object(f"{tag.replace(' ', '_')}/{i}", episode)
 
             result = evaluate(
-                env, policy, source.describe(), cfg.n_trials, cfg.seed, env_cfg.episode_length, on_trial=on_trial
+                env,
+                policy,
+                source.describe(),
+                cfg.n_trials,
+                cfg.seed,
+                env_cfg.episode_length,
+                on_trial=on_trial,
+                record_trials=viz is not None,
             )
             result.step = step
             results.append(result)

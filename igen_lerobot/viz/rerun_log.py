@@ -87,7 +87,7 @@ class EpisodeLogger:
     # ------------------------------------------------------------------ episodes
     def log_episode(
         self,
-        index: int,
+        index: int | str,
         state: np.ndarray,
         env_state: np.ndarray,
         action: np.ndarray,
@@ -170,7 +170,7 @@ class EpisodeLogger:
             columns=rr.TextLog.columns(text=[text for _, text in events]),
         )
 
-    def log_episode_object(self, index: int, episode, source_paths: dict[int, np.ndarray] | None = None) -> None:
+    def log_episode_object(self, index: int | str, episode, source_paths: dict[int, np.ndarray] | None = None) -> None:
         """:meth:`log_episode` for an :class:`~igen_lerobot.episode.Episode`."""
         self.log_episode(
             index,
@@ -185,7 +185,7 @@ class EpisodeLogger:
             source_paths=source_paths,
         )
 
-    def log_outcome(self, index: int, success: bool, reason: str = "") -> None:
+    def log_outcome(self, index: int | str, success: bool, reason: str = "") -> None:
         """An attempt or trial that left no episode (dropped by the generator, or an evaluation trial)."""
         text = f"{index}: {'success' if success else 'failure'}{f' ({reason})' if reason else ''}"
         self.stream.log("outcomes", self.rr.TextLog(text, level="INFO" if success else "WARN"))
