@@ -24,7 +24,7 @@ from lerobot_robot_igen.config_deploy import (
 from lerobot_robot_igen.deploy import deploy
 from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
 from lerobot_robot_igen.driver import ConnectionLostError
-from lerobot_robot_igen.perception.cube_pose import CubeNotVisibleError
+from lerobot_robot_igen.perception.cube_pose import CubeNotVisibleError, PoseRejectedError
 from lerobot_robot_igen.pose_source import SimTruthPose
 from lerobot_robot_igen.safety import SafetyLimits
 
@@ -214,12 +214,23 @@ class FlakyCamera(SimTruthPose):
         return super().read()
 
 
-def test_stale_perception_stops_after_max_pose_age(sim_arm):
+class DivergingICP(FlakyCamera):
+    """ICP fits that fail the gate after ``good`` frames."""
+
+    def read(self):
+        self.good -= 1
+        if self.good < 0:
+            raise PoseRejectedError("ICP fit rejected: fitness 0.41 (need >= 0.85), RMSE 7.9 mm (need <= 4.0 mm)")
+        return SimTruthPose.read(self)
+
+
+@pytest.mark.parametrize(("camera", "reason"), [(FlakyCamera, "out of view"), (DivergingICP, "ICP fit rejected")])
+def test_stale_perception_stops_after_max_pose_age(sim_arm, camera, reason):
     settings = LoopSettings(realtime=False, max_pose_age=0.5, contact_force_threshold=0.0)
-    outcome, _ = run(sim_arm, scripted_policy(), poses=FlakyCamera(sim_arm, 10), settings=settings)
+    outcome, _ = run(sim_arm, scripted_policy(), poses=camera(sim_arm, 10), settings=settings)
     # 10 good frames, then 0.5 s (10 periods at 20 Hz) on the last estimate, then a stop
     assert outcome.steps == 20 and outcome.perception_failures == 11
-    assert "max_pose_age=0.5" in outcome.fault and "out of view" in outcome.fault
+    assert "max_pose_age=0.5" in outcome.fault and reason in outcome.fault
 
 
 def test_no_cube_at_the_start_never_moves_the_arm(sim_arm):

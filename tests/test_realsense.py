@@ -174,3 +174,31 @@ def test_record_rgbd_refuses_bad_input(tmp_path):
         record_rgbd(tmp_path / "x.bag", [scene(0)], K)
     with pytest.raises(ConfigError, match="frame 0"):
         record_rgbd(tmp_path / "x.db3", [(np.zeros((10, 10, 3), np.uint8), np.zeros((10, 10)))], K)
+
+
+def test_a_recording_as_a_lerobot_camera_on_the_igen_franka_robot(recording):
+    """LeRobot's camera configs reach our capture: type igen_realsense plays the recording, frame after frame."""
+    from lerobot.robots.utils import make_robot_from_config
+
+    from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
+    from lerobot_robot_igen.config_recorded_realsense import RecordedRealSenseConfig
+
+    camera = RecordedRealSenseConfig(recording=str(recording), width=W, height=H, fps=30)
+    robot = make_robot_from_config(IgenFrankaConfig(cameras={"front": camera}, home_on_connect=False))
+    assert robot.observation_features["front"] == (H, W, 3)
+    robot.connect()
+    try:
+        blues = []
+        for _ in range(3):
+            image = robot.get_observation()["front"]
+            assert image.shape == (H, W, 3) and image.dtype == np.uint8
+            np.testing.assert_array_equal(image[SQUARE], np.broadcast_to((255, 0, 0), image[SQUARE].shape))
+            blues.append(int(image[0, 0, 2]))
+        assert blues == [0, 40, 80]  # the recorded frames in order, none dropped
+    finally:
+        robot.disconnect()
+    wrong = RecordedRealSenseConfig(recording=str(recording), width=320, height=240, fps=30)
+    robot = make_robot_from_config(IgenFrankaConfig(cameras={"front": wrong}, home_on_connect=False))
+    with pytest.raises(CameraError, match="320x240"):
+        robot.connect()
+    robot.disconnect()

@@ -138,3 +138,32 @@ def test_live_logging_during_generation(source_interventions, tmp_path):
         colors = column(chunks[f"/episodes/{index}/path"], "Points3D:colors")[0]
         generated = packed(phase_colors(np.array([Phase.GENERATED]))[0])
         assert sum(c == generated for c in colors) > 0  # a generated recovery in every kept episode
+
+
+def test_live_logging_during_evaluation(tmp_path):
+    """igen-eval --rerun.mode=save logs each trial's path, belief and outcome."""
+    out = tmp_path / "eval.rrd"
+    result = subprocess.run(
+        [
+            str(BIN / "igen-eval"),
+            "--task=block_grasp",
+            "--n_trials=2",
+            "--rerun.mode=save",
+            f"--rerun.path={out}",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr[-3000:]
+    chunks = read_rrd(out)
+    for trial in (0, 1):
+        root = f"/episodes/scripted/{trial}"
+        frames = column(chunks[f"{root}/eef"], "frame")
+        colors = column(chunks[f"{root}/path"], "Points3D:colors")[0]
+        assert len(colors) == len(frames) > 0
+        assert not any(c in RECOVERY_COLORS for c in colors)  # nobody intervenes in an evaluation
+        assert column(chunks[f"{root}/cube/believed"], "Boxes3D:centers")
+    outcomes = [text for row in column(chunks["/outcomes"], "TextLog:text") for text in row]
+    assert len(outcomes) == 2 and all("scripted" in text for text in outcomes)

@@ -6,5 +6,6 @@ libraries (franky, pyrealsense2, Open3D) load only where a backend is built.
 
 from lerobot_robot_igen.config_end_effector_target import EndEffectorTargetConfig
 from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
+from lerobot_robot_igen.config_recorded_realsense import RecordedRealSenseConfig
 
-__all__ = ["EndEffectorTargetConfig", "IgenFrankaConfig"]
+__all__ = ["EndEffectorTargetConfig", "IgenFrankaConfig", "RecordedRealSenseConfig"]

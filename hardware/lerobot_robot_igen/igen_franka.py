@@ -96,11 +96,15 @@ class IgenFranka(Robot):
             max_delta=self.config.max_step,
             refuse_delta=self.config.max_target_distance,
         )
-        self.cameras = make_cameras_from_configs(self.config.cameras)
-        for camera in self.cameras.values():
-            camera.connect()
-        if self.config.home_on_connect:
-            self.go_home()
+        try:
+            self.cameras = make_cameras_from_configs(self.config.cameras)
+            for camera in self.cameras.values():
+                camera.connect()
+            if self.config.home_on_connect:
+                self.go_home()
+        except BaseException:
+            self.disconnect()  # never leave a half-connected robot behind
+            raise
         if self.config.trace:
             Path(self.config.trace).parent.mkdir(parents=True, exist_ok=True)
             self._trace = open(self.config.trace, "a")  # noqa: SIM115 - lives as long as the connection
