@@ -68,7 +68,12 @@ class TableRun:
         self.out = Path(cfg.output_dir)
         self.bin = Path(sys.executable).parent
         self.commands: list[dict] = []
-        self.timings: dict[str, float] = {}
+        # step -> seconds, kept on disk so that a table resumed over several sessions still
+        # knows how long every step took
+        self.timings_file = self.out / "step_times.json"
+        self.timings: dict[str, float] = (
+            json.loads(self.timings_file.read_text()) if self.timings_file.exists() else {}
+        )
 
     def data(self, name: str) -> Path:
         return self.out / "data" / name
@@ -89,7 +94,10 @@ class TableRun:
         else:
             with open(log, "w") as sink:
                 code = subprocess.run(command, stdout=sink, stderr=subprocess.STDOUT, env=os.environ.copy()).returncode
-        self.timings[name] = time.perf_counter() - start
+        if code == 0 and done.exists():
+            self.timings[name] = time.perf_counter() - start
+            self.timings_file.parent.mkdir(parents=True, exist_ok=True)
+            self.timings_file.write_text(json.dumps(self.timings, indent=2))
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
@@ -352,7 +360,8 @@ def render_markdown(result: dict) -> str:
         f"checkpoint every {train['save_freq'] or train['steps']} steps, "
         f"device {train['device']}, seed {train['seed']}.",
         f"- `igen-eval`: every {cfg['eval_every']}. checkpoint, {cfg['n_trials']} trials from seed {cfg['eval_seed']}.",
-        f"- Wall time: {result['wall_time_s'] / 60:.1f} min (steps already done when the run started are not counted).",
+        f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
+        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
         "",
         "## Commands",
         "",
