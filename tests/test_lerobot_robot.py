@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -127,6 +128,22 @@ def replay_command(root: Path, repo_id: str, trace: Path, *arm: str) -> list[str
     ]
 
 
+@contextmanager
+def arm_args(kind: str):
+    """The ``--robot.arm.*`` arguments of an arm: the simulated one, or franky on a franky-sim server."""
+    if kind == "sim":
+        yield ["--robot.arm.type=sim"]
+        return
+    from franky_sim_server import franky_sim
+
+    with franky_sim(cube=None) as server:
+        yield ["--robot.arm.type=franky", f"--robot.arm.host={server.host}"]
+
+
+# Tolerances [m]: the simulated arm's OSC tracks tightly; the FR3 (acceleration/jerk at 5%) lags more.
+FOLLOW_TOLERANCE = {"sim": 0.01, "franky": 0.02}
+
+
 def run(command: list[str], log: Path) -> None:
     result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
     log.write_text(result.stdout + result.stderr)
@@ -157,29 +174,35 @@ def test_lerobot_replay_drives_the_robot_along_a_recorded_episode(square_dataset
     np.testing.assert_allclose(measured[:-1], np.array(recorded_path[1:]), atol=0.002)
 
 
-def test_lerobot_rollout_runs_a_policy_and_returns_home_smoothly(square_dataset, tmp_path):
+@pytest.fixture(scope="module")
+def square_policy(square_dataset, tmp_path_factory):
+    """A bc_rnn trained by lerobot-train on the recorded squares (3 steps: the plumbing, not a good policy)."""
     from igen_lerobot.training import TrainConfig, lerobot_train
 
     root, repo_id, _ = square_dataset
-    checkpoint = lerobot_train(
-        TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0), root, repo_id, tmp_path / "train"
-    )
+    config = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)
+    return lerobot_train(config, root, repo_id, tmp_path_factory.mktemp("square_train") / "bc_rnn")
+
+
+@pytest.mark.parametrize("arm", ["sim", "franky"])
+def test_lerobot_rollout_runs_a_policy_and_returns_home_smoothly(square_policy, arm, tmp_path):
     trace = tmp_path / "rollout.jsonl"
-    run(
-        [
-            str(BIN / "lerobot-rollout"),
-            "--strategy.type=base",
-            f"--policy.path={checkpoint}",
-            "--robot.type=igen_franka",
-            "--robot.arm.type=sim",
-            f"--robot.trace={trace}",
-            f"--fps={FPS}",
-            "--duration=2",
-            "--task=trace a square",
-            "--play_sounds=false",
-        ],
-        tmp_path / "rollout.log",
-    )
+    with arm_args(arm) as args:
+        run(
+            [
+                str(BIN / "lerobot-rollout"),
+                "--strategy.type=base",
+                f"--policy.path={square_policy}",
+                "--robot.type=igen_franka",
+                *args,
+                f"--robot.trace={trace}",
+                f"--fps={FPS}",
+                "--duration=2",
+                "--task=trace a square",
+                "--play_sounds=false",
+            ],
+            tmp_path / "rollout.log",
+        )
     lines = [json.loads(line) for line in trace.read_text().splitlines()]
     policy_steps = [line for line in lines if "ee.qw.pos" not in line["received"]]
     teardown = [line for line in lines if "ee.qw.pos" in line["received"]]
@@ -188,12 +211,13 @@ def test_lerobot_rollout_runs_a_policy_and_returns_home_smoothly(square_dataset,
     # the tear-down's targets move smoothly: no step larger than max_step (3 cm)
     sent = np.array([line["sent"] for line in lines])
     assert np.max(np.abs(np.diff(sent, axis=0))) <= 0.03 + 0.01
-    # and it ends where it started (tolerance: 1 cm)
+    # and it ends where it started
     initial = np.array([teardown[-1]["received"][k] for k in ("ee.x.pos", "ee.y.pos", "ee.z.pos")])
-    assert np.linalg.norm(np.array(teardown[-1]["measured"]) - initial) < 0.01
+    assert np.linalg.norm(np.array(teardown[-1]["measured"]) - initial) < FOLLOW_TOLERANCE[arm]
 
 
-def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_path):
+@pytest.mark.parametrize("arm", ["sim", "franky"])
+def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, arm, tmp_path):
     """A person holds Down then right Shift on LeRobot's keyboard (real X events, Xvfb) during lerobot-record."""
     import os
     import time
@@ -202,10 +226,11 @@ def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_p
 
     root, repo_id = tmp_path / "teleop", "local/igen_franka_teleop"
     env = {**os.environ, "DISPLAY": x_display, "PYTHONUNBUFFERED": "1"}
+    arm_context = ExitStack()
     command = [
         str(BIN / "lerobot-record"),
         "--robot.type=igen_franka",
-        "--robot.arm.type=sim",
+        *arm_context.enter_context(arm_args(arm)),
         "--teleop.type=igen_ee_target",
         "--teleop.device=keyboard_ee",
         f"--dataset.repo_id={repo_id}",
@@ -219,9 +244,9 @@ def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_p
         "--dataset.push_to_hub=false",
         "--play_sounds=false",
     ]
-    proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    lines = []
+    lines, proc = [], None
     try:
+        proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         for line in proc.stdout:  # wait until the episode is being recorded
             lines.append(line)
             if "Recording episode" in line:
@@ -241,8 +266,9 @@ def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_p
         out, _ = proc.communicate(timeout=300)
         lines.append(out)
     finally:
-        if proc.poll() is None:
+        if proc is not None and proc.poll() is None:
             proc.kill()
+        arm_context.close()
     assert proc.returncode == 0, "".join(lines)[-3000:]
     dataset = LeRobotDataset(repo_id, root=root)
     assert dataset.num_episodes == 1 and dataset.num_frames >= 0.8 * 6 * FPS
@@ -255,8 +281,8 @@ def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, tmp_p
     dy, dz = actions[-1, 1] - actions[0, 1], actions[-1, 2] - actions[0, 2]
     assert 0.08 <= dy <= 0.22 and 0.04 <= dz <= 0.16, (dy, dz)
     assert np.all(np.diff(actions[:, 1]) >= -1e-9) and abs(actions[-1, 0] + 0.05) < 1e-6
-    # and the robot followed its targets (tolerance 2 cm: the hand lags a moving target)
-    assert np.linalg.norm(state[-1, :3] - actions[-1, :3]) < 0.02
+    # and the robot followed its targets (it had 2.5 s of still targets to catch up)
+    assert np.linalg.norm(state[-1, :3] - actions[-1, :3]) < FOLLOW_TOLERANCE[arm]
 
 
 def test_lerobot_replay_drives_franky_sim_through_the_franky_backend(square_dataset, tmp_path):
