@@ -352,3 +352,16 @@ def test_deployment_logs_to_rerun(tmp_path):
     for entity in ("eef/measured", "eef/commanded", "cube/believed", "cube/perceived", "camera/color", "camera/depth"):
         assert rows.get(f"/deploy/{entity}") == 12, (entity, rows.get(f"/deploy/{entity}"))
     assert rows.get("/deploy/cube/cloud") == 12 and rows.get("/deploy/cube/icp_change_mm") == 11
+
+
+def test_a_missing_camera_leaves_no_arm_running(tmp_path):
+    import threading
+
+    from lerobot_robot_igen.perception.camera_model import save_extrinsics
+    from lerobot_robot_igen.realsense import CameraError
+
+    save_extrinsics(tmp_path / "calib.json", np.eye(4))
+    perception = RealSensePerceptionConfig(serial="000000000000", calibration=str(tmp_path / "calib.json"))
+    with pytest.raises(CameraError, match="000000000000"):
+        deploy(DeployConfig(robot=SimArmBackendConfig(), perception=perception, trials=1))
+    assert not any(t.name == "arm-watchdog" and t.is_alive() for t in threading.enumerate())

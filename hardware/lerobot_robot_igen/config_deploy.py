@@ -57,7 +57,7 @@ class RealSensePerceptionConfig(PerceptionConfig):
         if not self.calibration:
             raise ConfigError(
                 "--perception.calibration is required: a JSON file with the camera pose in the robot base "
-                "frame (T_base_camera), e.g. from a hand-eye calibration; see README 'Perception'"
+                "frame (T_base_camera), e.g. from a hand-eye calibration; see README 'Cube pose from RGB-D'"
             )
 
 

@@ -103,7 +103,12 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
     simulated = cfg.robot.simulated
     world_from_base = driver.world_from_base if driver.world_from_base is not None else cfg.real_world_from_base()
     arm = SafeArm(driver, world_from_base, cfg.safety)
-    poses = make_pose_source(cfg, driver)
+    try:
+        poses = make_pose_source(cfg, driver)
+    except BaseException:  # no camera: leave the arm stopped and the connection closed
+        arm.close()
+        driver.disconnect()
+        raise
     settings = LoopSettings(
         fps=cfg.fps,
         max_steps=cfg.max_steps,
