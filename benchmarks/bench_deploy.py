@@ -82,6 +82,7 @@ def main() -> None:
     def timing(rec):
         for key, value in rec.seconds.items():
             samples[key].append(value)
+
     for trial in range(args.trials):
         seed = episode_seed(args.seed, trial)
         frames, cam = [], {}

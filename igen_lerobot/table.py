@@ -71,9 +71,7 @@ class TableRun:
         # step -> seconds, kept on disk so that a table resumed over several sessions still
         # knows how long every step took
         self.timings_file = self.out / "step_times.json"
-        self.timings: dict[str, float] = (
-            json.loads(self.timings_file.read_text()) if self.timings_file.exists() else {}
-        )
+        self.timings: dict[str, float] = json.loads(self.timings_file.read_text()) if self.timings_file.exists() else {}
 
     def data(self, name: str) -> Path:
         return self.out / "data" / name
