@@ -323,6 +323,10 @@ def run_table(cfg: TableConfig) -> dict:
     return result
 
 
+def _every(k: int) -> str:
+    return "every" if k == 1 else f"every {k}-th"
+
+
 def render_markdown(result: dict) -> str:
     """The table, the protocol and the commands, for ``docs/results.md``."""
     cfg = result["config"]
@@ -357,7 +361,8 @@ def render_markdown(result: dict) -> str:
         f"{train['steps']} steps × batch {train['batch_size']}, "
         f"checkpoint every {train['save_freq'] or train['steps']} steps, "
         f"device {train['device']}, seed {train['seed']}.",
-        f"- `igen-eval`: every {cfg['eval_every']}. checkpoint, {cfg['n_trials']} trials from seed {cfg['eval_seed']}.",
+        f"- `igen-eval`: {_every(cfg['eval_every'])} saved checkpoint, {cfg['n_trials']} trials from seed "
+        f"{cfg['eval_seed']}; the best is reported.",
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
         "",
