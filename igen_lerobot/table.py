@@ -323,8 +323,8 @@ def run_table(cfg: TableConfig) -> dict:
     return result
 
 
-def _every(k: int) -> str:
-    return "every" if k == 1 else f"every {k}-th"
+def _which_checkpoints(k: int) -> str:
+    return "every saved checkpoint" if k == 1 else f"one in every {k} saved checkpoints"
 
 
 def render_markdown(result: dict) -> str:
@@ -361,7 +361,7 @@ def render_markdown(result: dict) -> str:
         f"{train['steps']} steps × batch {train['batch_size']}, "
         f"checkpoint every {train['save_freq'] or train['steps']} steps, "
         f"device {train['device']}, seed {train['seed']}.",
-        f"- `igen-eval`: {_every(cfg['eval_every'])} saved checkpoint, {cfg['n_trials']} trials from seed "
+        f"- `igen-eval`: {_which_checkpoints(cfg['eval_every'])}, {cfg['n_trials']} trials from seed "
         f"{cfg['eval_seed']}; the best is reported.",
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",

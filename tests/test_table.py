@@ -73,3 +73,15 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     assert rerun["step_times_s"] == report["step_times_s"]
     assert {c["step"] for c in rerun["commands"]} == set(report["step_times_s"])
     assert [r["success_rate"] for r in rerun["rows"]] == [r["success_rate"] for r in report["rows"]]
+
+
+def test_shipped_results_are_what_igen_table_renders_from_their_json():
+    """docs/results.md is the table igen-table wrote for docs/results.json: no hand-edited numbers."""
+    from igen_lerobot.table import render_markdown
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    result = json.loads((docs / "results.json").read_text())
+    assert [row["variant"] for row in result["rows"]] == list(VARIANTS)
+    assert (docs / "results.md").read_text() == render_markdown(result)
+    every_second = {**result, "config": {**result["config"], "eval_every": 2}}
+    assert "one in every 2 saved checkpoints, 50 trials" in render_markdown(every_second)
