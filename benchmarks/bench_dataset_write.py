@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 
 
 def synthetic(spec, rng, length):
-    from igen_lerobot.episode import Episode, EpisodeKind
+    from igen_lerobot.core.episode import Episode, EpisodeKind
 
     return Episode(
         task=spec.name,
@@ -38,7 +38,7 @@ def synthetic(spec, rng, length):
 
 
 def main() -> None:
-    from igen_lerobot.dataset.writer import DatasetBuilder
+    from igen_lerobot.datasets.writer import DatasetBuilder
     from lerobot_env_igen.block_grasp.spec import SPEC
 
     parser = argparse.ArgumentParser()

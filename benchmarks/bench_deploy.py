@@ -25,14 +25,14 @@ import numpy as np  # noqa: E402
 
 
 def _parts(policy_path):
-    from igen_lerobot.policies.source import PolicySourceConfig, make_base_policy
+    from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
 
     return make_base_policy(PolicySourceConfig(path=policy_path), BlockGraspEnvConfig())
 
 
 def run_trial(seed, policy, poses_factory, realtime, on_step=None):
-    from igen_lerobot.corruption import Reveal
+    from igen_lerobot.core.error_models import Reveal
     from lerobot_robot_igen.arm import SafeArm
     from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
     from lerobot_robot_igen.belief import CubeBelief
@@ -68,7 +68,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1_000_003)
     args = parser.parse_args()
 
-    from igen_lerobot.collect import episode_seed
+    from igen_lerobot.core.seeding import episode_seed
     from lerobot_robot_igen.deploy_loop import timing_stats
     from lerobot_robot_igen.perception.camera_model import Intrinsics
     from lerobot_robot_igen.pose_source import RealSenseICPPose, RenderedICPPose

@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 
 
 def time_env(steps: int) -> dict:
-    from igen_lerobot.corruption import NoNoise
+    from igen_lerobot.core.error_models import NoNoise
     from lerobot_env_igen.block_grasp.env import BlockGraspEnv
     from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator, ScriptedGraspPolicy
 

@@ -47,7 +47,7 @@ def bare_env_rate(env_cfg, steps=3000) -> float:
 
 
 def run(job, episodes, workers):
-    from igen_lerobot.dataset.spool import EpisodeSpool
+    from igen_lerobot.datasets.spool import EpisodeSpool
     from igen_lerobot.generation.runner import run_generation
 
     marks = []  # (time, kept so far, steps so far) after every finished attempt
@@ -124,8 +124,8 @@ def full_command(sources: str, episodes: int) -> dict:
 
 
 def main() -> None:
-    from igen_lerobot.dataset.reader import load_episodes
-    from igen_lerobot.env_config import task_config_class
+    from igen_lerobot.core.env_config import task_config_class
+    from igen_lerobot.datasets.reader import load_episodes
     from igen_lerobot.generation.job import GenerationJob, GenerationMode
     from igen_lerobot.generation.sources import parse_interventions
 

@@ -23,7 +23,7 @@ def main() -> None:
     parser.add_argument("--noise", type=float, default=0.001, help="depth noise std [m]")
     args = parser.parse_args()
 
-    from igen_lerobot.env_config import task_config_class
+    from igen_lerobot.core.env_config import task_config_class
     from lerobot_env_igen.rgbd import RGBDCamera, random_cube_view
     from lerobot_robot_igen.perception.camera_model import Intrinsics
     from lerobot_robot_igen.perception.cube_pose import CubePoseEstimator, PerceptionError, canonical_cube_rotation

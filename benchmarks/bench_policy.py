@@ -28,7 +28,7 @@ import numpy as np  # noqa: E402
 
 
 def training(dataset: Path, steps: int) -> dict:
-    from igen_lerobot.training import TrainConfig, train_command
+    from igen_lerobot.training.lerobot_train import TrainConfig, train_command
 
     with tempfile.TemporaryDirectory() as tmp:
         cfg = TrainConfig(steps=steps, batch_size=100, num_workers=2, extra_args=["--log_freq=1"])
@@ -55,8 +55,8 @@ def training(dataset: Path, steps: int) -> dict:
 
 
 def inference(checkpoint: Path, n: int = 2000) -> dict:
-    from igen_lerobot.env_config import task_config_class
-    from igen_lerobot.policies.lerobot_checkpoint import LeRobotCheckpointPolicy
+    from igen_lerobot.core.env_config import task_config_class
+    from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 
     cfg = task_config_class("block_grasp")()
     env = cfg.make_task_env()
@@ -81,9 +81,9 @@ def inference(checkpoint: Path, n: int = 2000) -> dict:
 
 
 def evaluation(checkpoint: Path, trials: int = 10) -> dict:
-    from igen_lerobot.env_config import task_config_class
-    from igen_lerobot.evaluation import evaluate
-    from igen_lerobot.policies.lerobot_checkpoint import LeRobotCheckpointPolicy
+    from igen_lerobot.core.env_config import task_config_class
+    from igen_lerobot.evaluation.trials import evaluate
+    from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 
     cfg = task_config_class("block_grasp")()
     env = cfg.make_task_env()

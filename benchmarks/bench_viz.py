@@ -57,8 +57,8 @@ def main() -> None:
     }
     print(json.dumps(report["generation"]), flush=True)
     if args.replay:
-        from igen_lerobot.dataset.reader import load_episodes, read_igen_meta
-        from igen_lerobot.env_config import task_config_class
+        from igen_lerobot.core.env_config import task_config_class
+        from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
         from igen_lerobot.viz.rerun_log import EpisodeLogger, RerunConfig
 
         root = Path(args.replay)

@@ -34,7 +34,7 @@ def x_display():
 
 @pytest.fixture(scope="session")
 def block_grasp_config():
-    from igen_lerobot.env_config import task_config_class
+    from igen_lerobot.core.env_config import task_config_class
 
     return task_config_class("block_grasp")()
 
@@ -49,9 +49,10 @@ def block_grasp_env(block_grasp_config):
 def _record_sources(tmp_path_factory, config, mode, n, seed):
     import dataclasses
 
-    from igen_lerobot.collect import episode_seed, record_demo, record_intervention
-    from igen_lerobot.corruption import NoNoise
-    from igen_lerobot.dataset.writer import DatasetBuilder
+    from igen_lerobot.collection.record import record_demo, record_intervention
+    from igen_lerobot.core.error_models import NoNoise
+    from igen_lerobot.core.seeding import episode_seed
+    from igen_lerobot.datasets.writer import DatasetBuilder
 
     if mode == "demos":
         config = dataclasses.replace(config, corruption=NoNoise())
@@ -91,7 +92,7 @@ def source_interventions(tmp_path_factory, block_grasp_config):
 @pytest.fixture(scope="session")
 def bc_rnn_checkpoint(source_demos, tmp_path_factory):
     """A BC-RNN checkpoint made by lerobot-train (3 steps: the plumbing, not a good policy)."""
-    from igen_lerobot.training import TrainConfig, lerobot_train
+    from igen_lerobot.training.lerobot_train import TrainConfig, lerobot_train
 
     cfg = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)
     return lerobot_train(cfg, source_demos, "local/block_grasp_demos", tmp_path_factory.mktemp("train") / "bc_rnn")

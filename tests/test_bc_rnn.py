@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import torch
 
-from igen_lerobot.dataset.reader import load_episodes
+from igen_lerobot.datasets.reader import load_episodes
 
 
 def test_bc_rnn_is_found_by_lerobot_plugin_discovery():
@@ -18,8 +18,8 @@ def test_bc_rnn_is_found_by_lerobot_plugin_discovery():
 def test_gmm_loss_is_the_negative_log_likelihood_and_ignores_padding():
     from lerobot.configs import FeatureType, PolicyFeature
 
-    from igen_lerobot.policies.bc_rnn.configuration_bc_rnn import BCRNNConfig
-    from igen_lerobot.policies.bc_rnn.modeling_bc_rnn import BCRNNPolicy
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.modeling_bc_rnn import BCRNNPolicy
 
     torch.manual_seed(0)
     config = BCRNNConfig(
@@ -54,8 +54,8 @@ def test_gmm_loss_is_the_negative_log_likelihood_and_ignores_padding():
 def test_rnn_state_is_reset_every_horizon_steps():
     from lerobot.configs import FeatureType, PolicyFeature
 
-    from igen_lerobot.policies.bc_rnn.configuration_bc_rnn import BCRNNConfig
-    from igen_lerobot.policies.bc_rnn.modeling_bc_rnn import BCRNNPolicy
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.modeling_bc_rnn import BCRNNPolicy
 
     config = BCRNNConfig(
         rnn_hidden_dim=8,
@@ -75,7 +75,7 @@ def test_rnn_state_is_reset_every_horizon_steps():
 
 
 def test_lerobot_train_checkpoint_loads_and_acts_in_our_env(bc_rnn_checkpoint, block_grasp_env, source_demos):
-    from igen_lerobot.policies.lerobot_checkpoint import LeRobotCheckpointPolicy
+    from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 
     policy = LeRobotCheckpointPolicy(bc_rnn_checkpoint, block_grasp_env.spec)
     assert policy.type == "bc_rnn"
@@ -94,8 +94,8 @@ def test_lerobot_train_checkpoint_loads_and_acts_in_our_env(bc_rnn_checkpoint, b
 def test_checkpoint_of_another_feature_set_is_rejected(bc_rnn_checkpoint, block_grasp_env):
     import dataclasses
 
-    from igen_lerobot.exceptions import TaskMismatchError
-    from igen_lerobot.policies.lerobot_checkpoint import LeRobotCheckpointPolicy
+    from igen_lerobot.core.exceptions import TaskMismatchError
+    from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 
     other = dataclasses.replace(block_grasp_env.spec, env_state_names=block_grasp_env.spec.env_state_names[:-1])
     with pytest.raises(TaskMismatchError, match="observation.environment_state of shape"):
@@ -106,7 +106,7 @@ def test_fast_rollout_sampler_draws_from_the_same_mixture():
     """select_action samples without distribution objects; it must match MixtureSameFamily.sample."""
     import torch
 
-    from igen_lerobot.policies.bc_rnn.modeling_bc_rnn import GMMHead
+    from igen_lerobot.training.bc_rnn.modeling_bc_rnn import GMMHead
 
     torch.manual_seed(0)
     head = GMMHead(in_dim=8, action_dim=3, num_modes=5, min_std=0.01)

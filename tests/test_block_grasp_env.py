@@ -5,9 +5,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from igen_lerobot.corruption import NoNoise, Reveal
-from igen_lerobot.env_config import known_tasks
-from igen_lerobot.task import OBS_ENV_STATE, OBS_STATE
+from igen_lerobot.core.env_config import known_tasks
+from igen_lerobot.core.error_models import NoNoise, Reveal
+from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE
 
 
 def run_scripted_operator(env, seed, max_steps=200):
@@ -144,7 +144,7 @@ def test_action_offsets_the_controller_goal_from_the_current_pose(block_grasp_en
 
 
 def test_fast_true_pose_vector_matches_the_generic_conversion(block_grasp_env):
-    from igen_lerobot.task import TaskEnv
+    from igen_lerobot.core.task import TaskEnv
 
     env = block_grasp_env
     env.reset(4)

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from igen_lerobot.dataset.reader import load_episodes
+from igen_lerobot.datasets.reader import load_episodes
 
 BIN = Path(sys.executable).parent
 
@@ -101,11 +101,11 @@ def test_collect_config_rejects_bad_flags_with_the_fix(args, message):
 
     import draccus
 
-    from igen_lerobot.config_collect import CollectConfig
-    from igen_lerobot.env_config import known_tasks
+    from igen_lerobot.collection.config_collect import CollectConfig
+    from igen_lerobot.core.env_config import known_tasks
 
     known_tasks()  # plugin discovery, as the console script does before parsing
-    from igen_lerobot.exceptions import ConfigError
+    from igen_lerobot.core.exceptions import ConfigError
     from igen_lerobot.scripts.cli import find_igen_error
 
     # draccus wraps our ConfigError in its own parsing error; the CLI digs it out (see cli.py)

@@ -4,10 +4,11 @@ import dataclasses
 
 import numpy as np
 
-from igen_lerobot.collect import episode_seed, record_demo, record_intervention
-from igen_lerobot.corruption import NoNoise
-from igen_lerobot.episode import EpisodeKind
-from igen_lerobot.task import FrameSource
+from igen_lerobot.collection.record import record_demo, record_intervention
+from igen_lerobot.core.episode import EpisodeKind
+from igen_lerobot.core.error_models import NoNoise
+from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.core.task import FrameSource
 
 
 def test_intervention_episode_is_policy_frames_then_operator_frames(block_grasp_config):

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from igen_lerobot.corruption import BoxNoise, NoNoise, RadialNoise
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.error_models import BoxNoise, NoNoise, RadialNoise
+from igen_lerobot.core.exceptions import ConfigError
 
 seeds = st.integers(0, 2**32 - 1)
 BLOCK_GRASP = BoxNoise(half_extent=(0.01, 0.07, 0.0), min_abs=(0.0, 0.025, 0.0), require="all")

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
 from lerobot_robot_igen.perception.camera_model import Intrinsics, load_extrinsics, save_extrinsics  # noqa: E402
 from lerobot_robot_igen.perception.cube_pose import (  # noqa: E402
     CUBE_SYMMETRIES,

@@ -8,12 +8,12 @@ import pandas as pd
 import pytest
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-from igen_lerobot.dataset.reader import load_episodes, read_igen_meta
-from igen_lerobot.dataset.schema import FRAME_SOURCE, IS_INTERVENTION, dataset_features
-from igen_lerobot.dataset.writer import DatasetBuilder
-from igen_lerobot.episode import Episode, EpisodeKind
-from igen_lerobot.exceptions import ConfigError, DatasetSchemaError, TaskMismatchError
-from igen_lerobot.task import FrameSource
+from igen_lerobot.core.episode import Episode, EpisodeKind
+from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError, TaskMismatchError
+from igen_lerobot.core.task import FrameSource
+from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
+from igen_lerobot.datasets.schema import FRAME_SOURCE, IS_INTERVENTION, dataset_features
+from igen_lerobot.datasets.writer import DatasetBuilder
 
 
 def synthetic_episode(spec, rng, length=30, kind=EpisodeKind.INTERVENTION, seed=0):

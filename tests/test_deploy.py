@@ -8,10 +8,10 @@ import time
 import numpy as np
 import pytest
 
-from igen_lerobot.collect import episode_seed
-from igen_lerobot.corruption import Reveal
-from igen_lerobot.evaluation import evaluate
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.error_models import Reveal
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.evaluation.trials import evaluate
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
 from lerobot_robot_igen.belief import CubeBelief
@@ -118,7 +118,7 @@ def test_rendered_camera_and_icp_in_the_loop():
 
 def test_a_trained_checkpoint_deploys(bc_rnn_checkpoint):
     """A lerobot-train checkpoint loads with its processors and runs the loop without a fault."""
-    from igen_lerobot.policies.source import PolicySourceConfig
+    from igen_lerobot.training.policy_source import PolicySourceConfig
 
     cfg = DeployConfig(
         policy=PolicySourceConfig(path=str(bc_rnn_checkpoint)),

@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from igen_lerobot.evaluation import EvalResult, best_result, evaluate, list_checkpoints, wilson_interval
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.evaluation.checkpoints import best_result, list_checkpoints
+from igen_lerobot.evaluation.trials import EvalResult, evaluate, wilson_interval
 
 BIN = Path(sys.executable).parent
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}

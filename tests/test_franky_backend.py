@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from franky_sim_server import franky_sim, free_loopback, stop
 
-from igen_lerobot.corruption import Reveal
+from igen_lerobot.core.error_models import Reveal
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
 from lerobot_robot_igen.belief import CubeBelief

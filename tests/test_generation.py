@@ -5,16 +5,16 @@ import dataclasses
 import numpy as np
 import pytest
 
-from igen_lerobot.corruption import NoNoise
-from igen_lerobot.dataset.reader import load_episodes
-from igen_lerobot.episode import EpisodeKind
-from igen_lerobot.exceptions import DatasetSchemaError, TaskMismatchError
+from igen_lerobot.core.episode import EpisodeKind
+from igen_lerobot.core.error_models import NoNoise
+from igen_lerobot.core.exceptions import DatasetSchemaError, TaskMismatchError
+from igen_lerobot.core.geometry import make_pose, transform_segment
+from igen_lerobot.core.task import FrameSource
+from igen_lerobot.datasets.reader import load_episodes
 from igen_lerobot.generation.intervengen import IntervenGenConfig, MistakeSource, generate_intervention
 from igen_lerobot.generation.mimicgen import MimicGenConfig, generate_demo
 from igen_lerobot.generation.selection import Selection, select_segment
 from igen_lerobot.generation.sources import SegmentRole, parse_demos, parse_interventions
-from igen_lerobot.geometry import make_pose, transform_segment
-from igen_lerobot.task import FrameSource
 
 
 @pytest.fixture(scope="module")

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from igen_lerobot.dataset.merge import merge_datasets
-from igen_lerobot.dataset.reader import load_episodes, read_igen_meta
-from igen_lerobot.dataset.spool import EpisodeSpool
-from igen_lerobot.dataset.writer import DatasetBuilder
-from igen_lerobot.exceptions import TaskMismatchError
+from igen_lerobot.core.exceptions import TaskMismatchError
+from igen_lerobot.datasets.merge import merge_datasets
+from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
+from igen_lerobot.datasets.spool import EpisodeSpool
+from igen_lerobot.datasets.writer import DatasetBuilder
 from igen_lerobot.generation.job import GenerationJob, GenerationMode
 from igen_lerobot.generation.runner import run_generation
 from igen_lerobot.generation.sources import parse_interventions
@@ -172,7 +172,7 @@ def test_worker_processes_load_a_plugin_policy_checkpoint(job, bc_rnn_checkpoint
     """Each worker registers LeRobot plugins itself before loading the bc_rnn checkpoint."""
     import dataclasses
 
-    from igen_lerobot.policies.source import PolicySourceConfig
+    from igen_lerobot.training.policy_source import PolicySourceConfig
 
     with_policy = dataclasses.replace(job, policy=PolicySourceConfig(path=str(bc_rnn_checkpoint)), max_steps=320)
     spool = EpisodeSpool(tmp_path / "attempts")
@@ -185,7 +185,7 @@ def test_a_job_whose_workers_cannot_start_stops_with_their_error(job, tmp_path):
     import dataclasses
 
     from igen_lerobot.generation.runner import GenerationSetupError
-    from igen_lerobot.policies.source import PolicySourceConfig
+    from igen_lerobot.training.policy_source import PolicySourceConfig
 
     broken = dataclasses.replace(job, policy=PolicySourceConfig(path=str(tmp_path / "no_such_checkpoint")))
     with pytest.raises(GenerationSetupError, match="has no config.json"):

@@ -5,7 +5,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from igen_lerobot.geometry import (
+from igen_lerobot.core.geometry import (
     interpolate_poses,
     make_pose,
     pos_quat_to_pose,

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
 from lerobot_robot_igen.safety import SafetyGuard, SafetyLimits, SafetyViolationError, Watchdog
 
 

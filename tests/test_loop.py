@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from igen_lerobot.dataset.reader import load_episodes, read_igen_meta
+from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
 
 
 def test_two_iterations_grow_the_dataset_and_resume_without_redoing(source_demos, tmp_path):

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-from igen_lerobot.dataset.merge import weighted_repeats
-from igen_lerobot.dataset.schema import IS_INTERVENTION, dataset_features
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.datasets.merge import weighted_repeats
+from igen_lerobot.datasets.schema import IS_INTERVENTION, dataset_features
 
 BIN = Path(sys.executable).parent
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}

@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from igen_lerobot.exceptions import ConfigError, IgenError  # noqa: E402
+from igen_lerobot.core.exceptions import ConfigError, IgenError  # noqa: E402
 from lerobot_robot_igen.perception.camera_model import Intrinsics  # noqa: E402
 from lerobot_robot_igen.realsense import (  # noqa: E402
     CameraError,

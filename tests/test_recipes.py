@@ -5,9 +5,9 @@ from pathlib import Path
 import draccus
 import pytest
 
-from igen_lerobot.config_collect import CollectConfig
-from igen_lerobot.config_generate import GenerateConfig
-from igen_lerobot.env_config import known_tasks
+from igen_lerobot.collection.config_collect import CollectConfig
+from igen_lerobot.core.env_config import known_tasks
+from igen_lerobot.generation.config_generate import GenerateConfig
 
 RECIPES = sorted((Path(__file__).parents[1] / "datasets" / "recipes").glob("*.yaml"))
 CONFIGS = {"collect": CollectConfig, "generate": GenerateConfig}

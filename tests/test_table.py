@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from igen_lerobot.config_table import VARIANTS
-from igen_lerobot.dataset.reader import load_episodes
-from igen_lerobot.table import LABELS
+from igen_lerobot.datasets.reader import load_episodes
+from igen_lerobot.experiments.config_table import VARIANTS
+from igen_lerobot.experiments.table import LABELS
 
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
 
@@ -77,7 +77,7 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
 
 def test_shipped_results_are_what_igen_table_renders_from_their_json():
     """docs/results.md is the table igen-table wrote for docs/results.json: no hand-edited numbers."""
-    from igen_lerobot.table import render_markdown
+    from igen_lerobot.experiments.table import render_markdown
 
     docs = Path(__file__).resolve().parents[1] / "docs"
     result = json.loads((docs / "results.json").read_text())

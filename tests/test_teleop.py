@@ -17,10 +17,10 @@ import json, os, subprocess, time
 import numpy as np
 from lerobot.teleoperators.keyboard.configuration_keyboard import KeyboardEndEffectorTeleopConfig
 from lerobot.teleoperators.keyboard.teleop_keyboard import KeyboardEndEffectorTeleop
-from igen_lerobot.agents import Operator
-from igen_lerobot.collect import record_intervention
-from igen_lerobot.env_config import task_config_class
-from igen_lerobot.teleop import TeleopOperator
+from igen_lerobot.core.agents import Operator
+from igen_lerobot.collection.record import record_intervention
+from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.collection.teleop import TeleopOperator
 
 PRESS, RELEASE = 8, 20
 cfg = task_config_class("block_grasp")()

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from igen_lerobot.dataset.reader import load_episodes
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.datasets.reader import load_episodes
 from igen_lerobot.viz.phases import RECOVERY_PHASES, Phase, phase_colors
 from igen_lerobot.viz.replay import replay_dataset
 from igen_lerobot.viz.rerun_log import RerunConfig
@@ -103,7 +103,7 @@ def test_igen_viz_cli_writes_a_recording_and_names_missing_fields(source_interve
     assert "Replayed 1 episodes" in result.stdout
     assert {k for k in read_rrd(out) if k.startswith("/episodes/")} >= {"/episodes/1/path", "/episodes/1/eef"}
     with pytest.raises(ConfigError, match="--output"):
-        from igen_lerobot.config_viz import VizConfig, VizDatasetConfig
+        from igen_lerobot.viz.config_viz import VizConfig, VizDatasetConfig
 
         VizConfig(dataset=VizDatasetConfig(root=str(source_interventions)))
     with pytest.raises(ConfigError, match="rerun.path"):

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from igen_lerobot.corruption import Reveal
-from igen_lerobot.task import OBS_ENV_STATE, OBS_STATE, TaskSpec
+from igen_lerobot.core.error_models import Reveal
+from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE, TaskSpec
 
 BLOCK_GRASP_STATE = ("eef.x", "eef.y", "eef.z", "eef.qx", "eef.qy", "eef.qz", "eef.qw", "gripper.width")
 BLOCK_GRASP_ENV_STATE = (

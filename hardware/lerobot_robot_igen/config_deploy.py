@@ -13,10 +13,10 @@ from dataclasses import dataclass, field
 import draccus
 import numpy as np
 
-from igen_lerobot.config_eval import EVAL_SEED
-from igen_lerobot.corruption import BoxNoise, PoseNoise, Reveal
-from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.policies.source import PolicySourceConfig
+from igen_lerobot.core.error_models import BoxNoise, PoseNoise, Reveal
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.evaluation.config_eval import EVAL_SEED
+from igen_lerobot.training.policy_source import PolicySourceConfig
 from igen_lerobot.viz.rerun_log import RerunConfig
 from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
 from lerobot_robot_igen.safety import SafetyLimits

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from lerobot.cameras import CameraConfig
 from lerobot.robots.config import RobotConfig
 
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
 from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
 from lerobot_robot_igen.config_end_effector_target import HOME_TARGET
 from lerobot_robot_igen.safety import SafetyLimits

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from lerobot.cameras.configs import CameraConfig
 
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
 
 
 @CameraConfig.register_subclass("igen_realsense")

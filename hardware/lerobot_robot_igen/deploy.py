@@ -13,9 +13,9 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from igen_lerobot.collect import episode_seed
-from igen_lerobot.evaluation import evaluate, wilson_interval
-from igen_lerobot.policies.source import make_base_policy
+from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.evaluation.trials import evaluate, wilson_interval
+from igen_lerobot.training.policy_source import make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.belief import CubeBelief, check_block_grasp_spec

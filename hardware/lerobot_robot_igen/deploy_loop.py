@@ -23,9 +23,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from igen_lerobot.agents import Policy
-from igen_lerobot.collect import RatePacer
-from igen_lerobot.exceptions import IgenError
+from igen_lerobot.core.agents import Policy
+from igen_lerobot.core.exceptions import IgenError
+from igen_lerobot.core.pacing import RatePacer
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.belief import CubeBelief, block_grasp_observation
 from lerobot_robot_igen.driver import ArmState, DriverError

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.exceptions import IgenError
+from igen_lerobot.core.exceptions import IgenError
 
 __all__ = ["ArmState", "ArmDriver", "DriverError", "ConnectionLostError"]
 

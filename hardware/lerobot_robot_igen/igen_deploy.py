@@ -11,7 +11,6 @@ Examples::
     igen-deploy --policy.path=... --robot.type=franky --robot.host=172.16.0.2 \
         --perception.type=realsense --perception.calibration=calib/T_base_camera.json --trials=10
 
-(No ``from __future__ import annotations`` here: LeRobot's parser reads the config type at runtime.)
 """
 
 import json
@@ -53,7 +52,7 @@ def deploy_main(cfg: DeployConfig) -> dict:
 
 def main() -> None:
     """Console entry point."""
-    run_cli(deploy_main, "igen-deploy")
+    run_cli(DeployConfig, deploy_main, "igen-deploy")
 
 
 if __name__ == "__main__":

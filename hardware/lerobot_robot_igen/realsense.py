@@ -22,7 +22,7 @@ from types import TracebackType
 import numpy as np
 import pyrealsense2 as rs
 
-from igen_lerobot.exceptions import ConfigError, IgenError
+from igen_lerobot.core.exceptions import ConfigError, IgenError
 from lerobot_robot_igen.perception.camera_model import Intrinsics
 
 

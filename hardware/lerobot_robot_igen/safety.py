@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from igen_lerobot.exceptions import ConfigError, IgenError
+from igen_lerobot.core.exceptions import ConfigError, IgenError
 
 
 class SafetyViolationError(IgenError, RuntimeError):

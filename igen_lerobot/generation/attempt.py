@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from igen_lerobot.episode import Episode
+from igen_lerobot.core.episode import Episode
 
 
 @dataclass

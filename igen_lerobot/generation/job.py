@@ -6,13 +6,13 @@ import enum
 import os
 from dataclasses import dataclass, field
 
-from igen_lerobot.collect import episode_seed
-from igen_lerobot.env_config import TaskEnvConfig
+from igen_lerobot.core.env_config import TaskEnvConfig
+from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.intervengen import IntervenGenConfig, MistakeSource, generate_intervention
 from igen_lerobot.generation.mimicgen import MimicGenConfig, generate_demo
 from igen_lerobot.generation.sources import SourceLibrary
-from igen_lerobot.policies.source import PolicySourceConfig, make_base_policy
+from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
 
 
 class GenerationMode(enum.StrEnum):

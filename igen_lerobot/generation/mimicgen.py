@@ -6,13 +6,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from igen_lerobot.episode import EpisodeKind
+from igen_lerobot.core.episode import EpisodeKind
+from igen_lerobot.core.recorder import EpisodeRecorder
+from igen_lerobot.core.task import TaskEnv
 from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.replay import ReplayConfig, replay_segment
 from igen_lerobot.generation.selection import Selection, select_segment
 from igen_lerobot.generation.sources import SegmentRole, SourceLibrary
-from igen_lerobot.recorder import EpisodeRecorder
-from igen_lerobot.task import TaskEnv
 
 
 @dataclass

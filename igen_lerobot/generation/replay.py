@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.geometry import interpolate_poses, transform_segment
+from igen_lerobot.core.recorder import EpisodeRecorder
+from igen_lerobot.core.task import FrameSource, StepInfo, TaskEnv
 from igen_lerobot.generation.sources import SourceSegment
-from igen_lerobot.geometry import interpolate_poses, transform_segment
-from igen_lerobot.recorder import EpisodeRecorder
-from igen_lerobot.task import FrameSource, StepInfo, TaskEnv
 
 
 @dataclass

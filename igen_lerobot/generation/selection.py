@@ -14,9 +14,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from igen_lerobot.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.geometry import pose_inv, rotation_angle
 from igen_lerobot.generation.sources import SourceSegment
-from igen_lerobot.geometry import pose_inv, rotation_angle
 
 ROTATION_WEIGHT = 0.05  # [m per rad]: 1 rad of orientation counts like 5 cm of position
 

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from igen_lerobot.episode import Episode
-from igen_lerobot.exceptions import DatasetSchemaError, TaskMismatchError
-from igen_lerobot.geometry import pose_inv
-from igen_lerobot.task import FrameSource, TaskSpec
+from igen_lerobot.core.episode import Episode
+from igen_lerobot.core.exceptions import DatasetSchemaError, TaskMismatchError
+from igen_lerobot.core.geometry import pose_inv
+from igen_lerobot.core.task import FrameSource, TaskSpec
 
 
 class SegmentRole(enum.StrEnum):

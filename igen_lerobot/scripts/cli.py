@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 
-from igen_lerobot.exceptions import IgenError
+from igen_lerobot.core.exceptions import IgenError
 
 
 def find_igen_error(error: BaseException) -> IgenError | None:
@@ -25,8 +25,12 @@ def find_igen_error(error: BaseException) -> IgenError | None:
     return None
 
 
-def run_cli(main_fn: Callable[..., object], prog: str) -> None:
-    """Parse the command line into ``main_fn``'s config (LeRobot's parser) and run it."""
+def run_cli(config_class: type, command: Callable[..., object], prog: str) -> None:
+    """Parse the command line into ``config_class`` (LeRobot's parser) and run ``command`` on it.
+
+    LeRobot's parser reads the config type from the wrapped function's annotation at run time;
+    the small typed entry below gives it one, so library functions keep postponed annotations.
+    """
     from lerobot.configs import parser
     from lerobot.utils.import_utils import register_third_party_plugins
     from lerobot.utils.utils import init_logging
@@ -34,10 +38,19 @@ def run_cli(main_fn: Callable[..., object], prog: str) -> None:
     init_logging()
     register_third_party_plugins()
     try:
-        parser.wrap()(main_fn)()
+        parser.wrap()(_typed_entry(config_class, command))()
     except Exception as error:  # noqa: BLE001 - re-raised unless it is one of ours
         ours = find_igen_error(error)
         if ours is None:
             raise
         print(f"{prog}: error: {ours}", file=sys.stderr)
         raise SystemExit(2) from None
+
+
+def _typed_entry(config_class: type, command: Callable[..., object]) -> Callable[..., object]:
+    def entry(cfg):  # noqa: ANN001 - annotated below, with the real class rather than a string
+        return command(cfg)
+
+    entry.__annotations__ = {"cfg": config_class}
+    entry.__name__ = getattr(command, "__name__", "main")
+    return entry

@@ -14,116 +14,16 @@ Examples::
     igen-collect --env.type=block_grasp --mode=interventions --operator=teleop --teleop.type=keyboard_ee
 
 Re-running an interrupted command resumes it (its work folder is ``<root>.partial``).
-(No ``from __future__ import annotations`` here: LeRobot's parser reads the config type at runtime.)
 """
 
-import logging
-
-import draccus
-from tqdm import tqdm
-
-from igen_lerobot.agents import Operator
-from igen_lerobot.collect import episode_seed, record_demo, record_intervention
-from igen_lerobot.config_collect import CollectConfig
-from igen_lerobot.corruption import NoNoise
-from igen_lerobot.dataset.writer import DatasetBuilder
-from igen_lerobot.env_config import TaskEnvConfig
-from igen_lerobot.policies.source import make_base_policy
+from igen_lerobot.collection.collect import collect
+from igen_lerobot.collection.config_collect import CollectConfig
 from igen_lerobot.scripts.cli import run_cli
-from igen_lerobot.viz.rerun_log import EpisodeLogger
-
-logger = logging.getLogger(__name__)
-
-
-def make_operator(cfg: CollectConfig, env_cfg: TaskEnvConfig) -> Operator:
-    """The scripted operator, or a person behind a connected LeRobot teleoperator."""
-    if cfg.operator == "scripted":
-        return env_cfg.make_scripted_operator()
-    from lerobot.teleoperators.utils import make_teleoperator_from_config
-
-    from igen_lerobot.teleop import TeleopOperator
-
-    operator = TeleopOperator(make_teleoperator_from_config(cfg.teleop), step_m=cfg.teleop_step, gate=cfg.teleop_gate)
-    operator.connect()
-    return operator
-
-
-def collect(cfg: CollectConfig) -> None:
-    """Record until ``num_episodes`` are kept, spooling every attempt so a rerun resumes."""
-    env_cfg: TaskEnvConfig = cfg.env  # type: ignore[assignment]  # checked in CollectConfig
-    if cfg.mode == "demos" and cfg.demo_observation == "true" and not isinstance(env_cfg.corruption, NoNoise):
-        logger.info("demos are recorded on true poses: overriding env.corruption with none")
-        env_cfg.corruption = NoNoise()
-    spec = env_cfg.task_spec
-    repo_id, root = cfg.dataset.resolve(f"{spec.name}_{cfg.mode}")
-    builder = DatasetBuilder(root, repo_id, spec, overwrite=cfg.dataset.overwrite)
-    spool = builder.spool
-    kept, done = len(spool.kept_attempts()), spool.done_attempts()
-    if builder.resuming:
-        logger.info("resuming %s: %d episodes kept from %d attempts", builder.work_dir, kept, len(done))
-    env = env_cfg.make_task_env()
-    operator = make_operator(cfg, env_cfg)
-    policy = make_base_policy(cfg.policy, env_cfg) if cfg.mode == "interventions" else None
-    rate = spec.fps if cfg.operator == "teleop" else None
-    viz = EpisodeLogger.open(cfg.rerun, spec, f"collect/{cfg.mode}")
-    try:
-        attempt = 0
-        with tqdm(total=cfg.num_episodes, initial=kept, desc=f"collecting {cfg.mode}", unit="ep") as bar:
-            while kept < cfg.num_episodes:
-                if attempt >= cfg.attempt_budget:
-                    raise RuntimeError(
-                        f"only {kept}/{cfg.num_episodes} episodes kept after {attempt} attempts; "
-                        f"rejections: {spool.rejection_reasons()}. Raise --max_attempts or check the operator."
-                    )
-                if attempt in done:
-                    attempt += 1
-                    continue
-                seed = episode_seed(cfg.seed, attempt)
-                if cfg.mode == "demos":
-                    episode = record_demo(env, operator, seed, env_cfg.episode_length, rate_hz=rate)
-                    reject = None if episode.success else "failed"
-                else:
-                    episode = record_intervention(env, policy, operator, seed, env_cfg.episode_length, rate_hz=rate)
-                    reject = (
-                        "failed"
-                        if not episode.success
-                        else "no_intervention"
-                        if not episode.is_intervention.any()
-                        else None
-                    )
-                if viz is not None:
-                    viz.log_episode_object(attempt, episode)
-                if reject is None:
-                    spool.keep(attempt, episode)
-                    kept += 1
-                    bar.update(1)
-                else:
-                    spool.reject(attempt, reject, seed=seed, length=episode.length)
-                    logger.info("attempt %d (seed %d) rejected: %s", attempt, seed, reject)
-                attempt += 1
-    finally:
-        operator.close()
-        env.close()
-        if viz is not None:
-            viz.close()
-    summary = builder.finalize(
-        cfg.num_episodes,
-        metadata={
-            "created_by": "igen-collect",
-            "mode": cfg.mode,
-            "seed": cfg.seed,
-            "operator": cfg.operator,
-            "policy": cfg.policy.describe() if cfg.mode == "interventions" else None,
-            "env": draccus.encode(env_cfg),
-            "rejections": spool.rejection_reasons(),
-        },
-    )
-    print(f"Wrote {summary.episodes} {cfg.mode} episodes ({summary.frames} frames) to {summary.root}")
 
 
 def main() -> None:
     """Console entry point ``igen-collect``."""
-    run_cli(collect, "igen-collect")
+    run_cli(CollectConfig, collect, "igen-collect")
 
 
 if __name__ == "__main__":

@@ -11,100 +11,16 @@ Examples::
     # the task's scripted base policy (trusts the corrupted pose)
     igen-eval --task=block_grasp
 
-(No ``from __future__ import annotations`` here: LeRobot's parser reads the config type at runtime.)
 """
 
-import dataclasses
-import json
-import logging
-from pathlib import Path
-
-from igen_lerobot.config_eval import EvalConfig
-from igen_lerobot.corruption import PoseNoise
-from igen_lerobot.evaluation import EvalResult, best_result, evaluate, list_checkpoints
-from igen_lerobot.policies.source import PolicySourceConfig, make_base_policy
+from igen_lerobot.evaluation.config_eval import EvalConfig
+from igen_lerobot.evaluation.evaluate import run_eval
 from igen_lerobot.scripts.cli import run_cli
-from igen_lerobot.viz.rerun_log import EpisodeLogger
-
-logger = logging.getLogger(__name__)
-
-
-def _line(result: EvalResult) -> str:
-    low, high = result.ci95
-    where = f"step {result.step}" if result.step is not None else result.policy
-    return (
-        f"{where}: {result.successes}/{result.trials} = {100 * result.success_rate:.0f}% "
-        f"(95% CI {100 * low:.0f}-{100 * high:.0f}%), mean {result.mean_steps:.0f} steps, {result.seconds:.0f} s"
-    )
-
-
-def run_eval(cfg: EvalConfig) -> dict:
-    """Evaluate one policy or a run's checkpoints; print and return (and optionally save) the results."""
-    env_cfg = cfg.env
-    targets: list[tuple[int | None, PolicySourceConfig]]
-    if cfg.train_dir:
-        targets = [
-            (step, PolicySourceConfig(path=str(path), device=cfg.policy.device))
-            for step, path in list_checkpoints(Path(cfg.train_dir), cfg.every)
-        ]
-    else:
-        targets = [(None, cfg.policy)]
-    env = env_cfg.make_task_env()
-    results = []
-    viz = EpisodeLogger.open(cfg.rerun, env_cfg.task_spec, "eval")
-    try:
-        for step, source in targets:
-            policy = make_base_policy(source, env_cfg)
-            on_trial = None
-            if viz is not None:
-                tag = f"step {step}" if step is not None else source.describe()
-
-                def on_trial(i, success, n, episode, tag=tag):
-                    viz.log_outcome(i, success, f"{tag}, {n} steps")
-                    viz.log_episode_object(f"{tag.replace(' ', '_')}/{i}", episode)
-
-            result = evaluate(
-                env,
-                policy,
-                source.describe(),
-                cfg.n_trials,
-                cfg.seed,
-                env_cfg.episode_length,
-                on_trial=on_trial,
-                record_trials=viz is not None,
-            )
-            result.step = step
-            results.append(result)
-            print(_line(result))
-    finally:
-        env.close()
-        if viz is not None:
-            viz.close()
-    best = best_result(results)
-    report = {
-        "task": env_cfg.type,
-        "n_trials": cfg.n_trials,
-        "seed": cfg.seed,
-        "corruption": {
-            "type": PoseNoise.get_choice_name(type(env_cfg.corruption)),
-            **dataclasses.asdict(env_cfg.corruption),
-        },
-        "reveal": str(env_cfg.reveal),
-        "results": [r.to_json() for r in results],
-        "best": best.to_json(),
-    }
-    if len(results) > 1:
-        print(f"best: {_line(best)}")
-    if cfg.output:
-        out = Path(cfg.output)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(json.dumps(report, indent=2))
-    return report
 
 
 def main() -> None:
     """Console entry point ``igen-eval``."""
-    run_cli(run_eval, "igen-eval")
+    run_cli(EvalConfig, run_eval, "igen-eval")
 
 
 if __name__ == "__main__":

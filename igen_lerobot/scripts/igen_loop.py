@@ -7,24 +7,16 @@ Example::
         --train.policy_type=bc_rnn --train.steps=2000 --output_dir=outputs/loop
 
 Re-running the same command resumes where it stopped.
-(No ``from __future__ import annotations`` here: LeRobot's parser reads the config type at runtime.)
 """
 
-import json
-
-from igen_lerobot.config_loop import LoopConfig
-from igen_lerobot.loop import run_loop
+from igen_lerobot.experiments.config_loop import LoopConfig
+from igen_lerobot.experiments.loop import loop_command
 from igen_lerobot.scripts.cli import run_cli
-
-
-def loop(cfg: LoopConfig) -> None:
-    """Run the iterations and print what they produced."""
-    print(json.dumps(run_loop(cfg), indent=2))
 
 
 def main() -> None:
     """Console entry point ``igen-loop``."""
-    run_cli(loop, "igen-loop")
+    run_cli(LoopConfig, loop_command, "igen-loop")
 
 
 if __name__ == "__main__":

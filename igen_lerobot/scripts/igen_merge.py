@@ -12,31 +12,16 @@ Examples::
 
 Train on the result with plain ``lerobot-train --dataset.root=...``: weighting is done by repeating
 episodes, so LeRobot's uniform sampler sees the requested proportions.
-(No ``from __future__ import annotations`` here: LeRobot's parser reads the config type at runtime.)
 """
 
-from pathlib import Path
-
-from igen_lerobot.config_merge import MergeConfig
-from igen_lerobot.dataset.merge import merge_datasets
-from igen_lerobot.env_config import task_config_class
+from igen_lerobot.datasets.config_merge import MergeConfig
+from igen_lerobot.datasets.merge import run_merge
 from igen_lerobot.scripts.cli import run_cli
-
-
-def merge(cfg: MergeConfig) -> Path:
-    """Check every input belongs to the task, then aggregate them (atomically)."""
-    spec = task_config_class(cfg.task)().task_spec
-    repo_id, root = cfg.dataset.resolve(Path(cfg.dataset.root).name)
-    merged = merge_datasets(
-        [Path(p) for p in cfg.inputs], root, repo_id, spec, overwrite=cfg.dataset.overwrite, weights=cfg.weights
-    )
-    print(f"Merged {len(cfg.inputs)} datasets into {merged}")
-    return merged
 
 
 def main() -> None:
     """Console entry point ``igen-merge``."""
-    run_cli(merge, "igen-merge")
+    run_cli(MergeConfig, run_merge, "igen-merge")
 
 
 if __name__ == "__main__":

@@ -10,25 +10,16 @@ Examples::
         --n_trials=2 --output_dir=outputs/table_smoke --results=outputs/table_smoke/results.md
 
 Re-running resumes: finished datasets, trainings and evaluations are reused.
-(No ``from __future__ import annotations`` here: LeRobot's parser reads the config type at runtime.)
 """
 
-from igen_lerobot.config_table import TableConfig
+from igen_lerobot.experiments.config_table import TableConfig
+from igen_lerobot.experiments.table import table_command
 from igen_lerobot.scripts.cli import run_cli
-from igen_lerobot.table import run_table
-
-
-def table(cfg: TableConfig) -> None:
-    """Run the table and print it."""
-    result = run_table(cfg)
-    for row in result["rows"]:
-        print(f"{row['label']:>18}: {100 * row['success_rate']:5.1f}%  (paper: {row['paper']})")
-    print(f"Wrote {cfg.results} and its JSON")
 
 
 def main() -> None:
     """Console entry point ``igen-table``."""
-    run_cli(table, "igen-table")
+    run_cli(TableConfig, table_command, "igen-table")
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import enum
 
 import numpy as np
 
-from igen_lerobot.task import FrameSource
+from igen_lerobot.core.task import FrameSource
 
 REVEALED_INDEX = -1  # observation.environment_state ends with the latched ``revealed`` flag
 

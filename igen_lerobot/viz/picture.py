@@ -19,7 +19,7 @@ from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_pha
 
 
 def draw_episode(episode, output: Path, title: str, half: float = 0.025) -> None:
-    """Render ``episode`` (an :class:`~igen_lerobot.episode.Episode`) to a PNG."""
+    """Render ``episode`` (an :class:`~igen_lerobot.core.episode.Episode`) to a PNG."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -75,8 +75,8 @@ def main() -> None:
     parser.add_argument("--output", default="docs/images/intervention_episode.png")
     args = parser.parse_args()
 
-    from igen_lerobot.dataset.reader import load_episodes, read_igen_meta
-    from igen_lerobot.env_config import task_config_class
+    from igen_lerobot.core.env_config import task_config_class
+    from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
 
     spec = task_config_class(read_igen_meta(Path(args.root)).task)().task_spec
     (episode,) = load_episodes(Path(args.root), spec, episodes=[args.episode])

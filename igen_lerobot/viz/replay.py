@@ -8,8 +8,9 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from igen_lerobot.dataset.reader import load_episodes, read_igen_meta
-from igen_lerobot.env_config import task_config_class
+from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
+from igen_lerobot.viz.config_viz import VizConfig
 from igen_lerobot.viz.rerun_log import EpisodeLogger, RerunConfig
 
 logger = logging.getLogger(__name__)
@@ -34,3 +35,13 @@ def replay_dataset(
     finally:
         log.close()
     return {"episodes": len(loaded), "frames": frames, "seconds": time.perf_counter() - start}
+
+
+def replay_command(cfg: VizConfig) -> dict:
+    """``igen-viz``: replay into a file or a viewer, and say what was written."""
+    rerun = RerunConfig(mode="spawn") if cfg.spawn else RerunConfig(mode="save", path=cfg.output)
+    result = replay_dataset(Path(cfg.dataset.root), rerun, cfg.dataset.repo_id, cfg.episodes)
+    where = cfg.output or "the viewer"
+    counts = f"{result['episodes']} episodes ({result['frames']} frames)"
+    print(f"Replayed {counts} into {where} in {result['seconds']:.1f} s")
+    return result

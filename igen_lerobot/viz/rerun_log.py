@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.task import TaskSpec
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_phases, phase_colors
 
 logger = logging.getLogger(__name__)
@@ -171,7 +171,7 @@ class EpisodeLogger:
         )
 
     def log_episode_object(self, index: int | str, episode, source_paths: dict[int, np.ndarray] | None = None) -> None:
-        """:meth:`log_episode` for an :class:`~igen_lerobot.episode.Episode`."""
+        """:meth:`log_episode` for an :class:`~igen_lerobot.core.episode.Episode`."""
         self.log_episode(
             index,
             episode.state,

@@ -19,7 +19,7 @@ from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
 
 __all__ = ["BlockGraspEnvConfig"]
 
-_GYM_ENTRY_POINT = "igen_lerobot.gym_env:TaskGymEnv"
+_GYM_ENTRY_POINT = "igen_lerobot.core.gym_env:TaskGymEnv"
 
 for _config_cls in (BlockGraspEnvConfig,):
     _gym_id = f"lerobot_env_igen/{_config_cls.task}"

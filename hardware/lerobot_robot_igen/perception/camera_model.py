@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.geometry import pos_quat_to_pose
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.geometry import pos_quat_to_pose
 
 
 @dataclass(frozen=True)

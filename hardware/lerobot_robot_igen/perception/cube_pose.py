@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from igen_lerobot.exceptions import IgenError
+from igen_lerobot.core.exceptions import IgenError
 from lerobot_robot_igen.perception.camera_model import Intrinsics
 
 

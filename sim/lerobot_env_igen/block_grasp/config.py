@@ -7,11 +7,11 @@ from dataclasses import dataclass, field
 from lerobot.configs import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
 
-from igen_lerobot.agents import Operator, Policy
-from igen_lerobot.corruption import PoseNoise
-from igen_lerobot.env_config import TaskEnvConfig
-from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskEnv, TaskSpec
+from igen_lerobot.core.agents import Operator, Policy
+from igen_lerobot.core.env_config import TaskEnvConfig
+from igen_lerobot.core.error_models import PoseNoise
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskEnv, TaskSpec
 from lerobot_env_igen.block_grasp.spec import SPEC, paper_corruption
 
 

@@ -21,10 +21,10 @@ import logging
 import mujoco
 import numpy as np
 
-from igen_lerobot.corruption import PoseNoise, Reveal
-from igen_lerobot.exceptions import ConfigError
-from igen_lerobot.geometry import make_pose
-from igen_lerobot.task import StepInfo, TaskEnv
+from igen_lerobot.core.error_models import PoseNoise, Reveal
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.geometry import make_pose
+from igen_lerobot.core.task import StepInfo, TaskEnv
 from lerobot_env_igen.block_grasp.spec import CUBE_HALF, LIFT_SUCCESS, SPEC, paper_corruption
 from lerobot_env_igen.panda import PandaArm
 from lerobot_env_igen.scene import CUBE_RGBA, TABLE_TOP_Z, build_panda_table_scene

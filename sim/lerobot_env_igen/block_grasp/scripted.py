@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.agents import Operator
-from igen_lerobot.task import TaskEnv
+from igen_lerobot.core.agents import Operator
+from igen_lerobot.core.task import TaskEnv
 from lerobot_env_igen.block_grasp.env import CUBE_HALF, BlockGraspEnv
 
 GRIPPER_OPEN_WIDTH = 0.078  # [m] fingers count as open above this

@@ -1,7 +1,7 @@
 """Block Grasp's static description: importable without MuJoCo or robosuite."""
 
-from igen_lerobot.corruption import BoxNoise
-from igen_lerobot.task import SubtaskSpec, TaskSpec
+from igen_lerobot.core.error_models import BoxNoise
+from igen_lerobot.core.task import SubtaskSpec, TaskSpec
 
 CUBE_HALF = 0.025  # [m] half side of the 5 cm cube
 LIFT_SUCCESS = 0.04  # [m] the cube must rise this much above its resting height

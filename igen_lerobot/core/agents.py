@@ -1,0 +1,49 @@
+"""Who acts in an episode: a policy (sees only observations) and an operator (may take over).
+
+Human-gated interventions: before every step the operator decides whether it is in control;
+its steps are the recovery ("intervention") frames, the policy's are the mistake frames.
+"""
+
+from __future__ import annotations
+
+import abc
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from igen_lerobot.core.task import TaskEnv
+
+__all__ = ["Policy", "Operator"]
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """Anything that maps the robot's observation to an action (scripted or learned)."""
+
+    def reset(self) -> None:
+        """Forget episode state (e.g. an RNN's hidden state)."""
+
+    def act(self, observation: dict[str, np.ndarray]) -> np.ndarray:
+        """Action for one step from ``observation.state`` / ``observation.environment_state``."""
+
+
+class Operator(abc.ABC):
+    """A person behind a teleop device, or a scripted stand-in that sees true poses."""
+
+    def reset(self, env: TaskEnv) -> None:  # noqa: B027 - optional hook
+        """Called after every env reset."""
+
+    @abc.abstractmethod
+    def wants_control(self, env: TaskEnv, in_control: bool) -> bool:
+        """Whether the operator drives the next step (``in_control``: whether it drove the last)."""
+
+    @abc.abstractmethod
+    def act(self, env: TaskEnv) -> np.ndarray:
+        """The operator's action for the next step."""
+
+    def ends_episode(self) -> bool:
+        """Whether the operator asked to stop the episode now (e.g. a teleop 'quit' key)."""
+        return False
+
+    def close(self) -> None:  # noqa: B027 - optional hook
+        """Release devices."""

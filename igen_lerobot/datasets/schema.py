@@ -1,0 +1,97 @@
+"""The interventional dataset schema: LeRobot v3 features plus igen's per-frame columns.
+
+Policies read only ``observation.*`` and ``action``; everything igen adds lives under
+``complementary_info.*`` (LeRobot's own prefix for per-frame extras in its human-in-the-loop
+recordings, e.g. ``complementary_info.is_intervention``), so ``lerobot-train`` ignores it and
+LeRobot's merge/split tools carry it along. Per-episode facts (seed, corruption) are stored on
+every frame of the episode for the same reason.
+
+| feature | dtype, shape | meaning |
+|---|---|---|
+| observation.state | float32 (S,) | end-effector position [m], quaternion xyzw, gripper width [m] |
+| observation.environment_state | float32 (E,) | object poses as the robot believes them, contact, revealed |
+| action | float32 (A,) | the task's action (Block Grasp: delta position [m], gripper -1 open / +1 close) |
+| complementary_info.is_intervention | bool (1,) | an operator (or a replayed recovery) produced this action |
+| complementary_info.frame_source | int64 (1,) | 0 policy, 1 operator, 2 generated, 3 generated interpolation |
+| complementary_info.subtask_index | int64 (1,) | object-centric subtask the frame belongs to |
+| complementary_info.true_object_pose | float32 (7k,) | privileged true object poses (position + quat xyzw) |
+| complementary_info.corruption | float32 (3k,) | the episode's pose error per object [m] |
+| complementary_info.episode_seed | int64 (1,) | seed that reproduces the scene and the corruption |
+| complementary_info.episode_kind | int64 (1,) | demo / intervention / mimicgen / igen / igen_no_policy (index) |
+| complementary_info.success | bool (1,) | whether the episode ended in success |
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from igen_lerobot.core.episode import Episode, EpisodeKind
+from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, FrameSource, TaskSpec
+
+SCHEMA_VERSION = 1
+IS_INTERVENTION = "complementary_info.is_intervention"
+FRAME_SOURCE = "complementary_info.frame_source"
+SUBTASK_INDEX = "complementary_info.subtask_index"
+TRUE_OBJECT_POSE = "complementary_info.true_object_pose"
+CORRUPTION = "complementary_info.corruption"
+EPISODE_SEED = "complementary_info.episode_seed"
+EPISODE_KIND = "complementary_info.episode_kind"
+EPISODE_SUCCESS = "complementary_info.success"
+
+IGEN_COLUMNS = (
+    IS_INTERVENTION,
+    FRAME_SOURCE,
+    SUBTASK_INDEX,
+    TRUE_OBJECT_POSE,
+    CORRUPTION,
+    EPISODE_SEED,
+    EPISODE_KIND,
+    EPISODE_SUCCESS,
+)
+
+
+def dataset_features(spec: TaskSpec) -> dict[str, dict]:
+    """LeRobot ``features`` for a task's interventional dataset."""
+    return {
+        OBS_STATE: {"dtype": "float32", "shape": (len(spec.state_names),), "names": list(spec.state_names)},
+        OBS_ENV_STATE: {"dtype": "float32", "shape": (len(spec.env_state_names),), "names": list(spec.env_state_names)},
+        ACTION: {"dtype": "float32", "shape": (len(spec.action_names),), "names": list(spec.action_names)},
+        IS_INTERVENTION: {"dtype": "bool", "shape": (1,), "names": None},
+        FRAME_SOURCE: {"dtype": "int64", "shape": (1,), "names": [s.name.lower() for s in FrameSource]},
+        SUBTASK_INDEX: {"dtype": "int64", "shape": (1,), "names": [s.name for s in spec.subtasks]},
+        TRUE_OBJECT_POSE: {
+            "dtype": "float32",
+            "shape": (len(spec.object_pose_names),),
+            "names": list(spec.object_pose_names),
+        },
+        CORRUPTION: {"dtype": "float32", "shape": (len(spec.corruption_names),), "names": list(spec.corruption_names)},
+        EPISODE_SEED: {"dtype": "int64", "shape": (1,), "names": None},
+        EPISODE_KIND: {"dtype": "int64", "shape": (1,), "names": list(EpisodeKind.ALL)},
+        EPISODE_SUCCESS: {"dtype": "bool", "shape": (1,), "names": None},
+    }
+
+
+def episode_frames(episode: Episode, spec: TaskSpec) -> Iterator[dict]:
+    """LeRobot ``add_frame`` dicts for one validated episode."""
+    episode.validate(spec)
+    corruption = np.asarray(episode.corruption, dtype=np.float32)
+    seed = np.array([episode.seed], dtype=np.int64)
+    kind = np.array([EpisodeKind.ALL.index(episode.kind)], dtype=np.int64)
+    success = np.array([episode.success], dtype=bool)
+    for t in range(episode.length):
+        yield {
+            OBS_STATE: episode.state[t].astype(np.float32),
+            OBS_ENV_STATE: episode.env_state[t].astype(np.float32),
+            ACTION: episode.action[t].astype(np.float32),
+            IS_INTERVENTION: np.array([bool(episode.is_intervention[t])]),
+            FRAME_SOURCE: np.array([int(episode.source[t])], dtype=np.int64),
+            SUBTASK_INDEX: np.array([int(episode.subtask[t])], dtype=np.int64),
+            TRUE_OBJECT_POSE: episode.true_object_pose[t].astype(np.float32),
+            CORRUPTION: corruption,
+            EPISODE_SEED: seed,
+            EPISODE_KIND: kind,
+            EPISODE_SUCCESS: success,
+            "task": spec.instruction,
+        }

@@ -1,0 +1,148 @@
+"""Turn spooled episodes into a LeRobot v3 dataset without ever leaving a half-written one.
+
+Work happens in ``<root>.partial/`` (the spool of attempts, then the dataset being built); only a
+finished dataset is renamed to ``<root>``. An interrupted run leaves ``<root>.partial/`` behind,
+and running the same command again resumes from it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import shutil
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from tqdm import tqdm
+
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.task import TaskSpec
+from igen_lerobot.datasets.schema import SCHEMA_VERSION, dataset_features, episode_frames
+from igen_lerobot.datasets.spool import EpisodeSpool
+
+logger = logging.getLogger(__name__)
+
+IGEN_META_FILE = "meta/igen.json"
+
+
+@contextlib.contextmanager
+def _image_embedding_skipped(features: dict[str, dict]) -> Iterator[None]:
+    """Skip LeRobot's per-row image-embedding pass when a dataset has no image columns.
+
+    ``DatasetWriter`` maps ``embed_table_storage`` over every row of every episode; with no
+    image or video feature that pass changes nothing but costs ~70% of the write time
+    (``docs/benchmarks.md``). The output is identical (tested in ``tests/test_dataset_io.py``).
+    """
+    from lerobot.datasets import dataset_writer
+
+    if any(ft["dtype"] in ("image", "video") for ft in features.values()) or not hasattr(
+        dataset_writer, "embed_images"
+    ):
+        yield
+        return
+    original = dataset_writer.embed_images
+    dataset_writer.embed_images = lambda dataset: dataset
+    try:
+        yield
+    finally:
+        dataset_writer.embed_images = original
+
+
+@dataclass
+class BuildSummary:
+    """What :meth:`DatasetBuilder.finalize` wrote."""
+
+    root: Path
+    episodes: int
+    frames: int
+    seconds: float
+
+
+class DatasetBuilder:
+    """Owns ``<root>.partial/`` for one dataset being recorded or generated."""
+
+    def __init__(self, root: Path, repo_id: str, spec: TaskSpec, overwrite: bool = False) -> None:
+        self.root = Path(root)
+        self.repo_id = repo_id
+        self.spec = spec
+        if self.root.exists() and not overwrite:
+            raise ConfigError(
+                f"dataset.root {self.root} already exists. Choose a new --dataset.root, or pass "
+                "--dataset.overwrite=true to replace it once the new dataset is complete."
+            )
+        self.work_dir = self.root.with_name(self.root.name + ".partial")
+        self.resuming = (self.work_dir / "attempts").exists()
+        self._check_work_dir_task()
+        self.spool = EpisodeSpool(self.work_dir / "attempts")
+
+    def _check_work_dir_task(self) -> None:
+        marker = self.work_dir / "task.json"
+        if marker.exists():
+            recorded = json.loads(marker.read_text())
+            if recorded.get("task") != self.spec.name:
+                raise ConfigError(
+                    f"{self.work_dir} holds an interrupted run of task {recorded.get('task')!r}, not "
+                    f"{self.spec.name!r}; pick another --dataset.root or delete that folder."
+                )
+        else:
+            self.work_dir.mkdir(parents=True, exist_ok=True)
+            marker.write_text(json.dumps({"task": self.spec.name}))
+
+    def finalize(self, num_episodes: int | None, metadata: dict, fast_write: bool = True) -> BuildSummary:
+        """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at ``root``."""
+        from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+        import datasets
+
+        datasets.disable_progress_bars()  # one bar per episode otherwise; ours covers the whole write
+
+        start = time.perf_counter()
+        kept = self.spool.kept_attempts()
+        count = len(kept) if num_episodes is None else min(num_episodes, len(kept))
+        if count == 0:
+            raise ConfigError(f"no episode was kept in {self.spool.directory}; nothing to write")
+        build_dir = self.work_dir / "lerobot"
+        if build_dir.exists():
+            shutil.rmtree(build_dir)  # a build interrupted earlier: start it over from the spool
+        features = dataset_features(self.spec)
+        dataset = LeRobotDataset.create(
+            repo_id=self.repo_id,
+            fps=self.spec.fps,
+            features=features,
+            root=build_dir,
+            robot_type=self.spec.robot_type,
+            use_videos=False,
+        )
+        frames = 0
+        kinds: dict[str, int] = {}
+        skip = _image_embedding_skipped(features) if fast_write else contextlib.nullcontext()
+        with skip:
+            for _, episode in tqdm(self.spool.iter_kept(count), total=count, desc="writing dataset", unit="ep"):
+                for frame in episode_frames(episode, self.spec):
+                    dataset.add_frame(frame)
+                dataset.save_episode()
+                frames += episode.length
+                kinds[episode.kind] = kinds.get(episode.kind, 0) + 1
+        dataset.finalize()
+        meta = {"schema_version": SCHEMA_VERSION, "task": self.spec.name, "episode_kinds": kinds, **metadata}
+        (build_dir / IGEN_META_FILE).write_text(json.dumps(meta, indent=2, default=str))
+        self._publish(build_dir)
+        seconds = time.perf_counter() - start
+        logger.info("wrote %d episodes (%d frames) to %s in %.1f s", count, frames, self.root, seconds)
+        return BuildSummary(self.root, count, frames, seconds)
+
+    def _publish(self, build_dir: Path) -> None:
+        """Swap the finished dataset into place; the old one (if overwriting) goes only after."""
+        old = None
+        if self.root.exists():
+            old = self.root.with_name(self.root.name + ".old")
+            if old.exists():
+                shutil.rmtree(old)
+            self.root.rename(old)
+        build_dir.rename(self.root)
+        if old is not None:
+            shutil.rmtree(old)
+        shutil.rmtree(self.work_dir)

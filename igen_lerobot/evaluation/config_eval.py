@@ -1,0 +1,38 @@
+"""Config of ``igen-eval`` (draccus, LeRobot style)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from lerobot.envs.configs import EnvConfig
+
+from igen_lerobot.core.env_config import resolve_task_env
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.training.policy_source import PolicySourceConfig
+from igen_lerobot.viz.rerun_log import RerunConfig
+
+EVAL_SEED = 1_000_003  # far from the seeds collection and generation use by default
+
+
+@dataclass
+class EvalConfig:
+    """Success rate over seeded trials under the task's pose error and reveal-on-contact."""
+
+    task: str | None = None  # shortcut for --env.type with the task's defaults (the paper's corruption)
+    env: EnvConfig | None = None
+    policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # one checkpoint (or scripted)
+    train_dir: str | None = None  # a lerobot-train --output_dir: evaluate its checkpoints, report the best
+    every: int = 1  # with --train_dir: every k-th saved checkpoint (the last one always)
+    n_trials: int = 50
+    seed: int = EVAL_SEED
+    output: str | None = None  # JSON file for the results
+    rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log each trial
+
+    def __post_init__(self) -> None:
+        self.env = resolve_task_env(self.task, self.env)
+        if self.policy.path and self.train_dir:
+            raise ConfigError("give --policy.path (one checkpoint) or --train_dir (all of a run's), not both")
+        if self.n_trials < 1:
+            raise ConfigError(f"--n_trials must be >= 1, got {self.n_trials}")
+        if self.every < 1:
+            raise ConfigError(f"--every must be >= 1, got {self.every}")

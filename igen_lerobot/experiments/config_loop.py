@@ -1,0 +1,38 @@
+"""Config of ``igen-loop``: the outer loop of Algorithm 1 (train -> collect -> generate, k times)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.generation.intervengen import IntervenGenConfig
+from igen_lerobot.training.lerobot_train import TrainConfig
+
+
+@dataclass
+class LoopConfig:
+    """IntervenGen's iterations: D <- D + generated interventions of the policy trained on D."""
+
+    task: str = "block_grasp"
+    base_dataset: str | None = None  # D: the base dataset (e.g. MimicGen demonstrations)
+    iterations: int = 1  # k
+    interventions: int = 10  # m: human-gated interventions collected per iteration
+    generated: int = 1000  # n: synthetic interventions per iteration
+    operator: str = "scripted"  # who intervenes (the scripted stand-in; a person: use igen-collect directly)
+    workers: int = 1
+    seed: int = 0
+    train: TrainConfig = field(default_factory=TrainConfig)
+    igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
+    train_final: bool = True  # also train the policy on the final D
+    output_dir: str = "outputs/loop"
+
+    def __post_init__(self) -> None:
+        task_config_class(self.task)  # a clear error for an unknown task, before any work
+        if self.base_dataset is None:
+            raise ConfigError("--base_dataset is required: the dataset D the first policy is trained on")
+        for name in ("iterations", "interventions", "generated", "workers"):
+            if getattr(self, name) < 1:
+                raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
+        if self.operator != "scripted":
+            raise ConfigError("--operator must be 'scripted' in igen-loop; record a person with igen-collect")

@@ -1,0 +1,125 @@
+"""``igen-generate``: parse the sources, run the attempts (resumably), write the dataset, optionally merge."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from pathlib import Path
+
+import draccus
+
+from igen_lerobot.core.episode import Episode
+from igen_lerobot.core.error_models import NoNoise
+from igen_lerobot.datasets.merge import merge_datasets
+from igen_lerobot.datasets.reader import load_episodes
+from igen_lerobot.datasets.writer import DatasetBuilder
+from igen_lerobot.generation.attempt import Attempt
+from igen_lerobot.generation.config_generate import GenerateConfig
+from igen_lerobot.generation.job import GenerationJob, GenerationMode
+from igen_lerobot.generation.runner import run_generation
+from igen_lerobot.generation.sources import parse_demos, parse_interventions
+from igen_lerobot.viz.rerun_log import EpisodeLogger
+
+logger = logging.getLogger(__name__)
+
+
+def live_logger(viz: EpisodeLogger, spool, sources: list[Episode]):
+    """Log each attempt as it finishes.
+
+    Kept episodes go whole (read back from the spool the worker wrote), with the source
+    recoveries they replayed; dropped attempts as an outcome line.
+    """
+
+    def on_result(attempt: int, result: Attempt) -> None:
+        if not result.kept:
+            viz.log_outcome(attempt, False, result.reason or "")
+            return
+        episode = result.episode if result.episode is not None else spool.load(attempt)
+        used = result.details.get("recoveries") or episode.extra.get("recoveries") or []
+        paths = {
+            int(k): sources[int(k)].state[sources[int(k)].is_intervention, :3]
+            for k in used
+            if 0 <= int(k) < len(sources)
+        }
+        viz.log_episode_object(attempt, episode, source_paths=paths)
+
+    return on_result
+
+
+def generate(cfg: GenerateConfig) -> None:
+    """Parse the sources, run the attempts (resumably), write the dataset, optionally merge."""
+    env_cfg = cfg.env
+    mode = cfg.generation_mode
+    if (
+        mode is GenerationMode.MIMICGEN
+        and cfg.demo_observation == "true"
+        and not isinstance(env_cfg.corruption, NoNoise)
+    ):
+        logger.info("MimicGen demonstrations observe true poses: overriding env.corruption with none")
+        env_cfg = dataclasses.replace(env_cfg, corruption=NoNoise())
+    spec = env_cfg.task_spec
+    source_root = Path(cfg.source.root)
+    episodes = load_episodes(source_root, spec, repo_id=cfg.source.repo_id)
+    probe = env_cfg.make_task_env()  # only its action <-> target conversion is used here
+    parse = parse_demos if mode is GenerationMode.MIMICGEN else parse_interventions
+    library = parse(episodes, spec, probe.target_pose_from_action, probe.gripper_command)
+    probe.close()
+    logger.info("sources: %d episodes, %d segments from %s", len(episodes), len(library.segments), source_root)
+
+    repo_id, root = cfg.dataset.resolve(f"{spec.name}_{mode.value}")
+    builder = DatasetBuilder(root, repo_id, spec, overwrite=cfg.dataset.overwrite)
+    # IntervenGen attempts get the policy's mistake budget on top of an episode (see IntervenGenConfig)
+    max_steps = env_cfg.episode_length + (0 if mode is GenerationMode.MIMICGEN else cfg.igen.mistake_budget)
+    job = GenerationJob(
+        mode=mode,
+        env_config=env_cfg,
+        library=library,
+        run_seed=cfg.seed,
+        max_steps=max_steps,
+        policy=cfg.policy,
+        mimicgen=cfg.mimicgen,
+        igen=cfg.igen,
+    )
+    viz = EpisodeLogger.open(cfg.rerun, spec, f"generate/{mode.value}")
+    try:
+        stats = run_generation(
+            job,
+            builder.spool,
+            cfg.num_episodes,
+            workers=cfg.workers,
+            backend=cfg.backend,
+            max_attempts=cfg.max_attempts or None,
+            ray_address=cfg.ray_address,
+            on_result=None if viz is None else live_logger(viz, builder.spool, episodes),
+        )
+    finally:
+        if viz is not None:
+            viz.close()
+    print(stats.summary())
+    kept = len(builder.spool.kept_attempts())
+    if kept < cfg.num_episodes:
+        raise SystemExit(
+            f"igen-generate: only {kept}/{cfg.num_episodes} episodes kept within the attempt budget; the spool in "
+            f"{builder.work_dir} is kept: re-run with a larger --max_attempts to continue"
+        )
+    summary = builder.finalize(
+        cfg.num_episodes,
+        metadata={
+            "created_by": "igen-generate",
+            "mode": mode.value,
+            "seed": cfg.seed,
+            "source": str(source_root),
+            "policy": cfg.policy.path or "scripted",
+            "config": draccus.encode(cfg),
+            "generation": {
+                "attempted": stats.attempted + stats.resumed_attempts,
+                "success_rate": stats.success_rate,
+                "dropped": builder.spool.rejection_reasons(),
+            },
+        },
+    )
+    print(f"Wrote {summary.episodes} {mode.value} episodes ({summary.frames} frames) to {summary.root}")
+    if cfg.merge_with:
+        merged = root.with_name(root.name + "_merged")
+        merge_datasets([Path(cfg.merge_with), root], merged, f"{repo_id}_merged", spec, overwrite=cfg.dataset.overwrite)
+        print(f"Merged {cfg.merge_with} + {root} into {merged}")

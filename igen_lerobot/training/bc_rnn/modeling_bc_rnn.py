@@ -1,0 +1,123 @@
+"""BC-RNN: an LSTM over low-dim observations with a Gaussian-mixture action head (robomimic).
+
+Training sees sequences of ``horizon`` steps (LeRobot delta timestamps) and maximises the
+log-likelihood of the recorded actions under the mixture, ignoring padded steps past an
+episode's end. At rollout the policy carries its RNN state from step to step and resets it
+every ``horizon`` steps and at every episode start.
+"""
+
+from __future__ import annotations
+
+import torch
+from lerobot.policies.pretrained import PreTrainedPolicy
+from torch import Tensor, nn
+from torch.distributions import Categorical, Independent, MixtureSameFamily, Normal
+
+from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+
+ACTION = "action"
+LOW_NOISE_STD = 1e-4
+
+
+class GMMHead(nn.Module):
+    """Per-step mixture of ``num_modes`` diagonal Gaussians over the (normalised) action."""
+
+    def __init__(self, in_dim: int, action_dim: int, num_modes: int, min_std: float) -> None:
+        super().__init__()
+        self.action_dim, self.num_modes, self.min_std = action_dim, num_modes, min_std
+        self.means = nn.Linear(in_dim, num_modes * action_dim)
+        self.scales = nn.Linear(in_dim, num_modes * action_dim)
+        self.logits = nn.Linear(in_dim, num_modes)
+
+    def parameters_of(self, features: Tensor, low_noise: bool = False) -> tuple[Tensor, Tensor, Tensor]:
+        """Mixture logits (..., K), component means and scales (..., K, A)."""
+        shape = (*features.shape[:-1], self.num_modes, self.action_dim)
+        means = torch.tanh(self.means(features).reshape(shape))
+        if low_noise:
+            scales = torch.full_like(means, LOW_NOISE_STD)
+        else:
+            scales = nn.functional.softplus(self.scales(features).reshape(shape)) + self.min_std
+        return self.logits(features), means, scales
+
+    def forward(self, features: Tensor, low_noise: bool = False) -> MixtureSameFamily:
+        logits, means, scales = self.parameters_of(features, low_noise)
+        components = Independent(Normal(means, scales), 1)
+        return MixtureSameFamily(Categorical(logits=logits), components)
+
+    def sample(self, features: Tensor, low_noise: bool = False) -> Tensor:
+        """A draw from the mixture, without building distribution objects (3x faster per control step)."""
+        logits, means, scales = self.parameters_of(features, low_noise)
+        flat = logits.reshape(-1, self.num_modes)
+        mode = torch.multinomial(torch.softmax(flat, dim=-1), 1).reshape(*logits.shape[:-1], 1, 1)
+        index = mode.expand(*logits.shape[:-1], 1, self.action_dim)
+        mean = means.gather(-2, index).squeeze(-2)
+        scale = scales.gather(-2, index).squeeze(-2)
+        return mean + scale * torch.randn_like(mean)
+
+
+class BCRNNPolicy(PreTrainedPolicy):
+    """Recurrent behaviour cloning (robomimic BC-RNN-GMM) for low-dim observations."""
+
+    config_class = BCRNNConfig
+    name = "bc_rnn"
+
+    def __init__(self, config: BCRNNConfig, **kwargs) -> None:
+        super().__init__(config)
+        config.validate_features()
+        self.config = config
+        self.input_keys = sorted(config.input_features)
+        in_dim = sum(config.input_features[k].shape[0] for k in self.input_keys)
+        rnn_cls = nn.LSTM if config.rnn_type == "LSTM" else nn.GRU
+        self.rnn = rnn_cls(in_dim, config.rnn_hidden_dim, config.rnn_num_layers, batch_first=True)
+        layers: list[nn.Module] = []
+        width = config.rnn_hidden_dim
+        for dim in config.mlp_dims:
+            layers += [nn.Linear(width, dim), nn.ReLU()]
+            width = dim
+        self.mlp = nn.Sequential(*layers)
+        action_dim = config.action_feature.shape[0]
+        self.head = GMMHead(width, action_dim, config.gmm_num_modes, config.gmm_min_std)
+        self.reset()
+
+    def get_optim_params(self) -> dict:
+        return self.parameters()
+
+    def reset(self) -> None:
+        """Forget the RNN state (called at every episode start)."""
+        self._hidden = None
+        self._steps = 0
+
+    def _inputs(self, batch: dict[str, Tensor]) -> Tensor:
+        return torch.cat([batch[k] for k in self.input_keys], dim=-1)
+
+    def _distribution(self, inputs: Tensor, hidden=None, low_noise: bool = False):
+        out, hidden = self.rnn(inputs, hidden)
+        return self.head(self.mlp(out), low_noise=low_noise), hidden
+
+    def forward(self, batch: dict[str, Tensor]) -> tuple[Tensor, dict]:
+        inputs = self._inputs(batch)  # (B, T, D) from LeRobot's delta timestamps
+        if inputs.dim() == 2:
+            inputs = inputs.unsqueeze(1)
+        actions = batch[ACTION]
+        if actions.dim() == 2:
+            actions = actions.unsqueeze(1)
+        dist, _ = self._distribution(inputs)
+        log_prob = dist.log_prob(actions)  # (B, T)
+        valid = ~batch["action_is_pad"] if "action_is_pad" in batch else torch.ones_like(log_prob, dtype=torch.bool)
+        loss = -(log_prob * valid).sum() / valid.sum().clamp_min(1)
+        return loss, {"log_likelihood": -loss.item()}
+
+    @torch.no_grad()
+    def predict_action_chunk(self, batch: dict[str, Tensor]) -> Tensor:
+        """One action per call (an RNN policy has no chunks): shape (B, 1, action_dim)."""
+        return self.select_action(batch).unsqueeze(1)
+
+    @torch.no_grad()
+    def select_action(self, batch: dict[str, Tensor]) -> Tensor:
+        self.eval()
+        if self._steps % self.config.horizon == 0:
+            self._hidden = None  # robomimic resets the RNN every `horizon` rollout steps
+        inputs = self._inputs(batch).unsqueeze(1)  # (B, 1, D)
+        out, self._hidden = self.rnn(inputs, self._hidden)
+        self._steps += 1
+        return self.head.sample(self.mlp(out), low_noise=self.config.low_noise_eval)[:, 0]

@@ -1,0 +1,83 @@
+"""A trained LeRobot policy checkpoint behind our :class:`~igen_lerobot.core.agents.Policy` protocol.
+
+The observation goes through the checkpoint's own saved pre/post-processors (normalisation,
+device), exactly as ``lerobot-eval`` does, so a policy sees what it saw in training.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from igen_lerobot.core.exceptions import ConfigError, TaskMismatchError
+from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskSpec
+
+logger = logging.getLogger(__name__)
+
+
+def check_policy_features(input_features: dict, output_features: dict, spec: TaskSpec, where: str) -> None:
+    """The checkpoint's inputs/outputs are exactly what the task provides, or a clear error."""
+    provided = {OBS_STATE: (len(spec.state_names),), OBS_ENV_STATE: (len(spec.env_state_names),)}
+    for key, feature in input_features.items():
+        shape = tuple(feature.shape)
+        if key not in provided:
+            raise TaskMismatchError(
+                f"{where} expects input {key!r} {shape}, which task {spec.name!r} does not provide "
+                f"(it provides {', '.join(f'{k} {v}' for k, v in provided.items())})"
+            )
+        if shape != provided[key]:
+            raise TaskMismatchError(f"{where} expects {key} of shape {shape}; task {spec.name!r} gives {provided[key]}")
+    action_shape = tuple(output_features[ACTION].shape) if ACTION in output_features else None
+    if action_shape != (len(spec.action_names),):
+        raise TaskMismatchError(
+            f"{where} outputs action of shape {action_shape}; task {spec.name!r} takes ({len(spec.action_names)},)"
+        )
+
+
+class LeRobotCheckpointPolicy:
+    """Loads ``pretrained_model/`` (config, weights, processors) and acts one step at a time."""
+
+    def __init__(self, path: str | Path, spec: TaskSpec, device: str = "cpu") -> None:
+        import torch
+        from lerobot.configs.policies import PreTrainedConfig
+        from lerobot.policies.factory import get_policy_class, make_pre_post_processors
+        from lerobot.utils.import_utils import register_third_party_plugins
+
+        # Plugin policy types (bc_rnn) must be registered in every process that loads one,
+        # generation workers included, not only in the one that parsed the command line.
+        register_third_party_plugins()
+
+        path = Path(path)
+        if not (path / "config.json").exists():
+            raise ConfigError(
+                f"policy path {path} has no config.json; point it at a checkpoint's pretrained_model/ folder, "
+                "e.g. outputs/train/<run>/checkpoints/last/pretrained_model"
+            )
+        config = PreTrainedConfig.from_pretrained(path)
+        config.device = device
+        check_policy_features(config.input_features, config.output_features, spec, f"policy {path}")
+        self.policy = get_policy_class(config.type).from_pretrained(path, config=config)
+        self.policy.eval()
+        overrides = {"device_processor": {"device": device}}
+        self.preprocessor, self.postprocessor = make_pre_post_processors(
+            config, pretrained_path=str(path), preprocessor_overrides=overrides
+        )
+        self.instruction = spec.instruction
+        self._torch = torch
+        self.type = config.type
+
+    def reset(self) -> None:
+        self.policy.reset()
+
+    def act(self, observation: dict[str, np.ndarray]) -> np.ndarray:
+        torch = self._torch
+        batch = {
+            OBS_STATE: torch.from_numpy(np.asarray(observation[OBS_STATE], dtype=np.float32))[None],
+            OBS_ENV_STATE: torch.from_numpy(np.asarray(observation[OBS_ENV_STATE], dtype=np.float32))[None],
+            "task": [self.instruction],
+        }
+        with torch.inference_mode():
+            action = self.postprocessor(self.policy.select_action(self.preprocessor(batch)))
+        return action[0].cpu().numpy().astype(float)
