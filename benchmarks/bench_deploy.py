@@ -32,10 +32,10 @@ def _parts(policy_path):
 
 
 def run_trial(seed, policy, poses_factory, realtime, on_step=None):
-    from igen_lerobot.core.error_models import Reveal
+    from igen_lerobot.core.belief import Reveal
     from lerobot_robot_igen.arm import SafeArm
     from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
-    from lerobot_robot_igen.belief import CubeBelief
+    from lerobot_robot_igen.belief import cube_belief
     from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
     from lerobot_robot_igen.safety import SafetyLimits
 
@@ -49,7 +49,7 @@ def run_trial(seed, policy, poses_factory, realtime, on_step=None):
             safe,
             poses,
             policy,
-            CubeBelief(arm.env.corruption, Reveal.FULL),
+            cube_belief(arm.env.corruption, Reveal.FULL),
             LoopSettings(realtime=realtime),
             lambda s, a: arm.task_success(),
             on_step,

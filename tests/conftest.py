@@ -92,7 +92,8 @@ def source_interventions(tmp_path_factory, block_grasp_config):
 @pytest.fixture(scope="session")
 def bc_rnn_checkpoint(source_demos, tmp_path_factory):
     """A BC-RNN checkpoint made by lerobot-train (3 steps: the plumbing, not a good policy)."""
-    from igen_lerobot.training.lerobot_train import TrainConfig, lerobot_train
+    from igen_lerobot.training.config_train import TrainConfig
+    from igen_lerobot.training.lerobot_train import lerobot_train
 
     cfg = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)
     return lerobot_train(cfg, source_demos, "local/block_grasp_demos", tmp_path_factory.mktemp("train") / "bc_rnn")

@@ -92,12 +92,14 @@ def test_lerobot_train_checkpoint_loads_and_acts_in_our_env(bc_rnn_checkpoint, b
 
 
 def test_checkpoint_of_another_feature_set_is_rejected(bc_rnn_checkpoint, block_grasp_env):
-    import dataclasses
-
     from igen_lerobot.core.exceptions import TaskMismatchError
     from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 
-    other = dataclasses.replace(block_grasp_env.spec, env_state_names=block_grasp_env.spec.env_state_names[:-1])
+    from igen_lerobot.core.belief import Reveal
+
+    # the same task under another reveal mode observes three more values (the direction hint)
+    other = block_grasp_env.spec.with_reveal(Reveal.DIRECTION)
+    assert len(other.env_state_names) == len(block_grasp_env.spec.env_state_names) + 3
     with pytest.raises(TaskMismatchError, match="observation.environment_state of shape"):
         LeRobotCheckpointPolicy(bc_rnn_checkpoint, other)
 

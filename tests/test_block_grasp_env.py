@@ -5,8 +5,9 @@ import dataclasses
 import numpy as np
 import pytest
 
+from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.env_config import known_tasks
-from igen_lerobot.core.error_models import NoNoise, Reveal
+from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE
 
 
@@ -51,7 +52,7 @@ def test_reveal_fires_on_first_contact_and_not_before(block_grasp_config):
                 np.testing.assert_allclose(env_state[:3], true_cube + offset, atol=1e-5)
                 np.testing.assert_allclose(true_cube[:2], start_cube[:2], atol=1e-4)  # not pushed
                 assert abs(true_cube[2] - start_cube[2]) < 1e-3  # (settles < 1 mm into its contact)
-                assert not env.arm.touching(env._cube_mask)
+                assert not env.parts_in_contact("gripper", "cube")
             info = env.step(policy.act(obs))
             obs = env.observe()
             if info.contact and first_contact is None:

@@ -8,13 +8,13 @@ import time
 import numpy as np
 import pytest
 
-from igen_lerobot.core.error_models import Reveal
+from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import evaluate
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
-from lerobot_robot_igen.belief import CubeBelief
+from lerobot_robot_igen.belief import cube_belief
 from lerobot_robot_igen.config_deploy import (
     DeployConfig,
     RealSensePerceptionConfig,
@@ -48,7 +48,7 @@ def scripted_policy():
 def run(arm, policy, poses=None, settings=None, seed=SEED, limits=None, on_step=None, watchdog=False):
     arm.reset_scene(seed)
     safe = SafeArm(arm, arm.world_from_base, limits or SafetyLimits(), watchdog=watchdog)
-    belief = CubeBelief(arm.env.corruption, Reveal.FULL)
+    belief = cube_belief(arm.env.corruption, Reveal.FULL)
     settings = settings or LoopSettings(realtime=False, contact_force_threshold=0.0)
     try:
         outcome = run_episode(

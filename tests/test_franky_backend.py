@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from franky_sim_server import franky_sim, free_loopback, stop
 
-from igen_lerobot.core.error_models import Reveal
+from igen_lerobot.core.belief import Reveal
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
-from lerobot_robot_igen.belief import CubeBelief
+from lerobot_robot_igen.belief import cube_belief
 from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ
 from lerobot_robot_igen.deploy import GraspLiftJudge
 from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
@@ -114,7 +114,7 @@ def test_the_deployment_loop_grasps_and_lifts_the_cube_at_20hz():
                 safe,
                 KnownCube(arm),
                 ScriptedGraspPolicy(),
-                CubeBelief(np.zeros(3), Reveal.FULL),
+                cube_belief(np.zeros(3), Reveal.FULL),
                 LoopSettings(realtime=True, max_steps=300),
                 GraspLiftJudge(),
                 on_step=lambda rec: widths.append(rec.state.gripper_width),

@@ -177,7 +177,8 @@ def test_lerobot_replay_drives_the_robot_along_a_recorded_episode(square_dataset
 @pytest.fixture(scope="module")
 def square_policy(square_dataset, tmp_path_factory):
     """A bc_rnn trained by lerobot-train on the recorded squares (3 steps: the plumbing, not a good policy)."""
-    from igen_lerobot.training.lerobot_train import TrainConfig, lerobot_train
+    from igen_lerobot.training.config_train import TrainConfig
+    from igen_lerobot.training.lerobot_train import lerobot_train
 
     root, repo_id, _ = square_dataset
     config = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from igen_lerobot.core.paper import VARIANTS
 from igen_lerobot.datasets.reader import load_episodes
-from igen_lerobot.experiments.config_table import VARIANTS
 from igen_lerobot.experiments.table import LABELS
 
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
@@ -40,7 +40,7 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     first = subprocess.run(cmd, capture_output=True, text=True, timeout=1200, env=ENV)
     assert first.returncode == 0, first.stderr[-4000:]
 
-    report = json.loads(results.with_suffix(".json").read_text())
+    report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
     assert [row["variant"] for row in report["rows"]] == list(VARIANTS)
     markdown = results.read_text()
     for row in report["rows"]:
@@ -68,7 +68,7 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     # rerun: everything is found complete, nothing is redone, same numbers
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=ENV)
     assert again.returncode == 0, again.stderr[-4000:]
-    rerun = json.loads(results.with_suffix(".json").read_text())
+    rerun = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
     # nothing redone: the step times on record are still the first run's, one per step that ran
     assert rerun["step_times_s"] == report["step_times_s"]
     assert {c["step"] for c in rerun["commands"]} == set(report["step_times_s"])
@@ -76,12 +76,14 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
 
 
 def test_shipped_results_are_what_igen_table_renders_from_their_json():
-    """docs/results.md is the table igen-table wrote for docs/results.json: no hand-edited numbers."""
-    from igen_lerobot.experiments.table import render_markdown
+    """docs/results.md is the page igen-table renders from docs/results/*.json: no hand-edited numbers."""
+    from igen_lerobot.experiments.table import load_results, render_markdown, render_page
 
     docs = Path(__file__).resolve().parents[1] / "docs"
-    result = json.loads((docs / "results.json").read_text())
-    assert [row["variant"] for row in result["rows"]] == list(VARIANTS)
-    assert (docs / "results.md").read_text() == render_markdown(result)
+    tables = load_results(docs / "results")
+    by_name = {result["name"]: result for result, _ in tables}
+    assert [row["variant"] for row in by_name["block_grasp"]["rows"]] == list(VARIANTS)
+    assert (docs / "results.md").read_text() == render_page(tables)
+    result = by_name["block_grasp"]
     every_second = {**result, "config": {**result["config"], "eval_every": 2}}
-    assert "one in every 2 saved checkpoints, 50 trials" in render_markdown(every_second)
+    assert "one in every 2 saved checkpoints, 50 trials" in "\n".join(render_markdown(every_second))

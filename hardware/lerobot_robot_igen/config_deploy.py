@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 import draccus
 import numpy as np
 
-from igen_lerobot.core.error_models import BoxNoise, PoseNoise, Reveal
+from igen_lerobot.core.belief import Reveal
+from igen_lerobot.core.error_models import BoxNoise, ErrorModel
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.evaluation.config_eval import EVAL_SEED
 from igen_lerobot.training.policy_source import PolicySourceConfig
@@ -72,7 +73,7 @@ class DeployConfig:
     seed: int = EVAL_SEED  # trial i of a rehearsal is igen-eval's trial i (same scene, same pose error)
     # Test-time pose error on the perceived cube, revealed on contact (real arms; a rehearsal uses
     # the scene's own error so that it meets igen-eval's situations).
-    corruption: PoseNoise = field(
+    corruption: ErrorModel = field(
         default_factory=lambda: BoxNoise(half_extent=(0.01, 0.07, 0.0), min_abs=(0.0, 0.025, 0.0), require="all")
     )
     reveal: Reveal = Reveal.FULL

@@ -18,7 +18,7 @@ from igen_lerobot.evaluation.trials import evaluate, wilson_interval
 from igen_lerobot.training.policy_source import make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
 from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.belief import CubeBelief, check_block_grasp_spec
+from lerobot_robot_igen.belief import check_deployable, cube_belief
 from lerobot_robot_igen.config_deploy import (
     DeployConfig,
     RealSensePerceptionConfig,
@@ -96,7 +96,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
 
     env_cfg = BlockGraspEnvConfig()
-    check_block_grasp_spec(env_cfg.task_spec)
+    check_deployable(env_cfg.task_spec)
     policy = make_base_policy(cfg.policy, env_cfg)
     driver = cfg.robot.make_driver()
     driver.connect()
@@ -147,7 +147,8 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
                     driver.move_home()
                     offset = cfg.corruption.sample(np.random.default_rng(seed))
                     judge = GraspLiftJudge()
-                outcome = run_episode(arm, poses, policy, CubeBelief(offset, cfg.reveal), settings, judge, record)
+                belief = cube_belief(offset, cfg.reveal)
+                outcome = run_episode(arm, poses, policy, belief, settings, judge, record, env_cfg.task_spec)
                 outcomes.append(outcome)
                 if not simulated:
                     driver.set_gripper(False)

@@ -24,10 +24,13 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from igen_lerobot.core.agents import Policy
+from igen_lerobot.core.belief import ObjectBelief
 from igen_lerobot.core.exceptions import IgenError
+from igen_lerobot.core.observation import observation as build_observation
 from igen_lerobot.core.pacing import RatePacer
+from igen_lerobot.core.task import OBS_ENV_STATE, TaskSpec
+from lerobot_env_igen.block_grasp.spec import SPEC as BLOCK_GRASP_SPEC
 from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.belief import CubeBelief, block_grasp_observation
 from lerobot_robot_igen.driver import ArmState, DriverError
 from lerobot_robot_igen.perception.cube_pose import PerceptionError
 from lerobot_robot_igen.pose_source import PoseReading, PoseSource
@@ -103,12 +106,17 @@ def run_episode(
     arm: SafeArm,
     poses: PoseSource,
     policy: Policy,
-    belief: CubeBelief,
+    belief: ObjectBelief,
     settings: LoopSettings,
     judge: Callable[[ArmState, np.ndarray], bool],
     on_step: Callable[[StepRecord], None] | None = None,
+    spec: TaskSpec = BLOCK_GRASP_SPEC,
 ) -> EpisodeOutcome:
-    """Run one episode; the arm is stopped (not disconnected) whatever happens."""
+    """Run one episode; the arm is stopped (not disconnected) whatever happens.
+
+    ``belief`` is the core's belief about the cube (the same model the simulator keeps);
+    ``spec`` gives the observation layout the policy was trained on.
+    """
     period = 1.0 / settings.fps
     max_stale = settings.max_pose_age
     pacer = RatePacer(settings.fps if settings.realtime else None)
@@ -146,10 +154,12 @@ def run_episode(
                     ) from err
             times["perception"].append(time.perf_counter() - start)
 
-            belief.update(state.external_force > settings.contact_force_threshold, T_world_eef)
+            felt = state.external_force > settings.contact_force_threshold
+            belief.update(felt, T_world_eef[:3, 3], T_world_cube)
             if belief.revealed and outcome.revealed_at is None:
                 outcome.revealed_at = step
-            observation = block_grasp_observation(T_world_eef, state.gripper_width, T_world_cube, belief)
+            believed = {spec.corrupted_object: belief.believed_pose(T_world_cube)}
+            observation = build_observation(spec, T_world_eef, state.gripper_width, believed, belief)
 
             start = time.perf_counter()
             action = np.asarray(policy.act(observation), dtype=float)
@@ -166,7 +176,7 @@ def run_episode(
                         state=state,
                         T_world_eef=T_world_eef,
                         T_world_cube=T_world_cube,
-                        believed_position=observation["observation.environment_state"][:3].astype(float),
+                        believed_position=observation[OBS_ENV_STATE][:3].astype(float),
                         observation=observation,
                         action=action,
                         target=target,

@@ -147,11 +147,11 @@ class IgenFranka(Robot):
             raise RuntimeError(f"{self} is not connected: call connect() first")
 
     def get_observation(self) -> dict:
-        from lerobot_robot_igen.belief import mujoco_quat_xyzw
+        from igen_lerobot.core.geometry import quat_xyzw_from_matrix
 
         self._require_connected()
         state, T_world_eef = self.arm.read()
-        pose = (*T_world_eef[:3, 3], *mujoco_quat_xyzw(T_world_eef[:3, :3]))
+        pose = (*T_world_eef[:3, 3], *quat_xyzw_from_matrix(T_world_eef[:3, :3]))
         observation = {key: float(value) for key, value in zip(POSE_KEYS, pose, strict=True)}
         observation[GRIPPER_KEY] = float(state.gripper_width)
         for name, camera in self.cameras.items():

@@ -1,67 +1,108 @@
-"""Observation corruption as data: small config objects sampled per episode with a seeded RNG.
+"""Observation error as data: small config objects sampled per episode with a seeded RNG.
 
-The paper's sources of pose error are uniform box noise with a minimum magnitude (Block Grasp,
-Nut Insertion, 2-Piece Assembly) and radial noise (Coffee). A sampled offset is recorded in
-the episode's data, so any episode can be replayed exactly.
-
-Once the robot touches the object, the error may be lifted (``Observability``): fully (the true
-pose becomes observable) or partially (only the first contact position is revealed).
+The paper's sources of error are uniform box noise on a position with a minimum magnitude
+(Block Grasp, Nut Insertion, 2-Piece Assembly), radial noise on a position (Coffee), and object
+geometry: the nut's handle on the other side than the pose estimate says (Nut-and-Peg
+Assembly). A model draws one sample per episode; the sample is a short vector whose value names
+come from the model (``dx, dy, dz`` for positions, ``flip`` for the handle side), recorded in every
+frame of the episode, so any episode can be replayed exactly. :meth:`ErrorModel.apply` turns the
+true pose of the corrupted object into the pose the robot believes.
 """
 
 from __future__ import annotations
 
 import abc
-import enum
 from dataclasses import dataclass, field
 
 import draccus
 import numpy as np
 
 from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.geometry import rot_z
 
-__all__ = ["PoseNoise", "BoxNoise", "RadialNoise", "NoNoise", "Reveal"]
+__all__ = ["ErrorModel", "BoxNoise", "RadialNoise", "NoNoise", "YawFlip", "POSITION_ERROR_NAMES"]
 
-
-class Reveal(enum.StrEnum):
-    """What the robot learns about an object's pose on contact with it."""
-
-    NONE = "none"  # the belief stays corrupted for the whole episode
-    FULL = "full"  # the true pose becomes observable from the first contact on
-    CONTACT_POSITION = "contact_position"  # only the mean first-contact position is revealed
+POSITION_ERROR_NAMES = ("dx", "dy", "dz")
 
 
 @dataclass
-class PoseNoise(draccus.ChoiceRegistry, abc.ABC):
-    """An additive position error [m] on an object's observed pose, drawn once per episode."""
+class ErrorModel(draccus.ChoiceRegistry, abc.ABC):
+    """An error on one object's observed pose, drawn once per episode."""
 
     @property
-    def dim(self) -> int:
-        return 3
+    @abc.abstractmethod
+    def names(self) -> tuple[str, ...]:
+        """Names of the sample's values, in order (the object's name is prefixed in datasets)."""
 
     @abc.abstractmethod
     def sample(self, rng: np.random.Generator) -> np.ndarray:
-        """Draw one offset (3,) [m] with the given generator."""
+        """Draw one sample with the given generator."""
 
     @abc.abstractmethod
-    def contains(self, offset: np.ndarray, atol: float = 1e-12) -> bool:
-        """Whether ``offset`` is a value this model can produce (used by tests and validation)."""
+    def contains(self, sample: np.ndarray, atol: float = 1e-12) -> bool:
+        """Whether ``sample`` is a value this model can produce (tests and validation)."""
+
+    @abc.abstractmethod
+    def apply(self, T_world_obj: np.ndarray, sample: np.ndarray) -> np.ndarray:
+        """The pose the robot believes, given the true pose ``T_world_obj`` and this episode's sample."""
+
+    @property
+    def type_name(self) -> str:
+        """The name this model is chosen by (``--env.corruption.type=...``)."""
+        return ErrorModel.get_choice_name(type(self))
+
+    def checked(self, sample: np.ndarray, field_name: str = "corruption") -> np.ndarray:
+        """``sample`` as a float vector of this model's size, or a clear error naming ``field_name``."""
+        sample = np.asarray(sample, dtype=float).reshape(-1)
+        if sample.shape != (len(self.names),):
+            raise ConfigError(
+                f"{field_name} must hold {len(self.names)} values {self.names} for error model "
+                f"{self.type_name!r}, got shape {sample.shape}"
+            )
+        return sample
 
 
-@PoseNoise.register_subclass("none")
+class _PositionOffset(ErrorModel):
+    """A world-frame offset [m] added to the object's position; the orientation stays true."""
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return POSITION_ERROR_NAMES
+
+    def apply(self, T_world_obj: np.ndarray, sample: np.ndarray) -> np.ndarray:
+        believed = np.array(T_world_obj, dtype=float)
+        believed[:3, 3] += np.asarray(sample, dtype=float)
+        return believed
+
+
+@ErrorModel.register_subclass("none")
 @dataclass
-class NoNoise(PoseNoise):
-    """The robot sees the true pose (full demonstrations, uncorrupted evaluation)."""
+class NoNoise(ErrorModel):
+    """The robot sees the true pose (full demonstrations, uncorrupted evaluation).
+
+    Its all-zero sample takes the shape of the task's own error (``layout``, set by the task's
+    config), so uncorrupted and corrupted datasets of one task share one schema.
+    """
+
+    layout: tuple[str, ...] = POSITION_ERROR_NAMES
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.layout)
 
     def sample(self, rng: np.random.Generator) -> np.ndarray:
-        return np.zeros(3)
+        return np.zeros(len(self.layout))
 
-    def contains(self, offset: np.ndarray, atol: float = 1e-12) -> bool:
-        return bool(np.all(np.abs(offset) <= atol))
+    def contains(self, sample: np.ndarray, atol: float = 1e-12) -> bool:
+        return bool(np.all(np.abs(np.asarray(sample, dtype=float)) <= atol))
+
+    def apply(self, T_world_obj: np.ndarray, sample: np.ndarray) -> np.ndarray:
+        return np.array(T_world_obj, dtype=float)
 
 
-@PoseNoise.register_subclass("box")
+@ErrorModel.register_subclass("box")
 @dataclass
-class BoxNoise(PoseNoise):
+class BoxNoise(_PositionOffset):
     """Uniform noise in ``[-half_extent, half_extent]`` per axis with a minimum magnitude.
 
     ``min_abs`` gives per-axis minimum magnitudes [m] (0 = no minimum). With
@@ -103,8 +144,8 @@ class BoxNoise(PoseNoise):
                 return offset
         raise ConfigError("corruption.min_abs leaves almost no admissible region; lower it")
 
-    def contains(self, offset: np.ndarray, atol: float = 1e-12) -> bool:
-        offset = np.asarray(offset, float)
+    def contains(self, sample: np.ndarray, atol: float = 1e-12) -> bool:
+        offset = np.asarray(sample, float)
         half, low = np.asarray(self.half_extent, float), np.asarray(self.min_abs, float)
         if np.any(np.abs(offset) > half + atol):
             return False
@@ -115,9 +156,9 @@ class BoxNoise(PoseNoise):
         return bool(meets.all() if self.require == "all" else meets.any())
 
 
-@PoseNoise.register_subclass("radial")
+@ErrorModel.register_subclass("radial")
 @dataclass
-class RadialNoise(PoseNoise):
+class RadialNoise(_PositionOffset):
     """Offset of uniform direction in the plane ``axes`` with a radius in [r_min, r_max] [m]."""
 
     r_min: float = 0.02
@@ -140,8 +181,45 @@ class RadialNoise(PoseNoise):
         offset[list(self.axes)] = radius * direction
         return offset
 
-    def contains(self, offset: np.ndarray, atol: float = 1e-12) -> bool:
-        offset = np.asarray(offset, float)
+    def contains(self, sample: np.ndarray, atol: float = 1e-12) -> bool:
+        offset = np.asarray(sample, float)
         others = [a for a in range(3) if a not in self.axes]
         radius = np.linalg.norm(offset[list(self.axes)])
         return bool(self.r_min - atol <= radius <= self.r_max + atol and np.all(np.abs(offset[others]) <= atol))
+
+
+@ErrorModel.register_subclass("flip")
+@dataclass
+class YawFlip(ErrorModel):
+    """A geometry error: with probability ``probability`` the object is turned by ``angle`` about its z axis.
+
+    Nut-and-Peg Assembly: for an identical observed nut pose the handle may be on either side
+    (true yaw = observed + pi). The sample is ``flip`` in {0, 1}.
+    """
+
+    probability: float = 0.5
+    angle: float = float(np.pi)  # [rad]
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.probability <= 1.0:
+            raise ConfigError(f"corruption.probability must be in [0, 1], got {self.probability}")
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return ("flip",)
+
+    def sample(self, rng: np.random.Generator) -> np.ndarray:
+        return np.array([1.0 if rng.uniform() < self.probability else 0.0])
+
+    def contains(self, sample: np.ndarray, atol: float = 1e-12) -> bool:
+        value = np.asarray(sample, dtype=float).reshape(-1)
+        if value.shape != (1,):
+            return False
+        allowed = [v for v, p in ((0.0, 1.0 - self.probability), (1.0, self.probability)) if p > 0]
+        return any(abs(value[0] - v) <= atol for v in allowed)
+
+    def apply(self, T_world_obj: np.ndarray, sample: np.ndarray) -> np.ndarray:
+        flip = float(np.asarray(sample, dtype=float).reshape(-1)[0])
+        believed = np.array(T_world_obj, dtype=float)
+        believed[:3, :3] = believed[:3, :3] @ rot_z(-self.angle * flip)
+        return believed

@@ -26,6 +26,11 @@ __all__ = [
     "rotation_angle",
     "transform_segment",
     "interpolate_poses",
+    "quat_xyzw_from_matrix",
+    "rotvec_from_matrix",
+    "matrix_from_rotvec",
+    "rot_z",
+    "pose_vector",
 ]
 
 
@@ -117,3 +122,50 @@ def interpolate_poses(T_start: np.ndarray, T_end: np.ndarray, num_steps: int) ->
     out[:, :3, :3] = slerp(fractions).as_matrix()
     out[:, :3, 3] = pos
     return out
+
+
+def quat_xyzw_from_matrix(rot: np.ndarray) -> np.ndarray:
+    """Quaternion (x, y, z, w) of a rotation matrix, with MuJoCo's choice between ``q`` and ``-q``.
+
+    ``q`` and ``-q`` are the same rotation; which one a policy sees is a convention it learns.
+    Observations are built with MuJoCo's (``mju_mat2Quat``: the largest component is positive),
+    here in numpy so the core, the simulator and the real robot all give the same numbers.
+    """
+    m = np.asarray(rot, dtype=float).reshape(9)
+    trace = m[0] + m[4] + m[8]
+    if trace > 0:
+        w = 0.5 * np.sqrt(1.0 + trace)
+        q = (w, 0.25 * (m[7] - m[5]) / w, 0.25 * (m[2] - m[6]) / w, 0.25 * (m[3] - m[1]) / w)
+    elif m[0] > m[4] and m[0] > m[8]:
+        x = 0.5 * np.sqrt(1.0 + m[0] - m[4] - m[8])
+        q = (0.25 * (m[7] - m[5]) / x, x, 0.25 * (m[1] + m[3]) / x, 0.25 * (m[2] + m[6]) / x)
+    elif m[4] > m[8]:
+        y = 0.5 * np.sqrt(1.0 - m[0] + m[4] - m[8])
+        q = (0.25 * (m[2] - m[6]) / y, 0.25 * (m[1] + m[3]) / y, y, 0.25 * (m[5] + m[7]) / y)
+    else:
+        z = 0.5 * np.sqrt(1.0 - m[0] - m[4] + m[8])
+        q = (0.25 * (m[3] - m[1]) / z, 0.25 * (m[2] + m[6]) / z, 0.25 * (m[5] + m[7]) / z, z)
+    quat_wxyz = np.asarray(q) / np.linalg.norm(q)
+    return quat_wxyz[[1, 2, 3, 0]]
+
+
+def pose_vector(pose: np.ndarray) -> np.ndarray:
+    """Position [m] + quaternion xyzw (MuJoCo's sign) of a 4x4 pose: the 7 numbers observations hold."""
+    pose = np.asarray(pose, dtype=float)
+    return np.concatenate([pose[:3, 3], quat_xyzw_from_matrix(pose[:3, :3])])
+
+
+def rotvec_from_matrix(rot: np.ndarray) -> np.ndarray:
+    """Axis-angle vector [rad] (axis times angle) of a rotation matrix."""
+    return Rotation.from_matrix(np.asarray(rot, dtype=float)).as_rotvec()
+
+
+def matrix_from_rotvec(rotvec: np.ndarray) -> np.ndarray:
+    """Rotation matrix of an axis-angle vector [rad]."""
+    return Rotation.from_rotvec(np.asarray(rotvec, dtype=float)).as_matrix()
+
+
+def rot_z(angle: float) -> np.ndarray:
+    """Rotation by ``angle`` [rad] about the z axis."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

@@ -17,11 +17,10 @@ import logging
 import shutil
 from pathlib import Path
 
-from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.exceptions import ConfigError, TaskMismatchError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_merge import MergeConfig
-from igen_lerobot.datasets.reader import check_features, read_igen_meta
+from igen_lerobot.datasets.reader import check_features, dataset_spec, read_igen_meta
 from igen_lerobot.datasets.schema import SCHEMA_VERSION
 from igen_lerobot.datasets.writer import IGEN_META_FILE
 
@@ -67,11 +66,11 @@ def merge_datasets(
         raise ConfigError(f"{output_root} exists; pick another output or pass overwrite")
     metas, frames = [], []
     for root in roots:
-        info = read_igen_meta(root)
+        info = read_igen_meta(root, "--inputs")
         if info.task != spec.name:
             raise TaskMismatchError(f"cannot merge {root}: it holds task {info.task!r}, not {spec.name!r}")
         lerobot_meta = LeRobotDatasetMetadata(f"local/{root.name}", root=root)
-        check_features(lerobot_meta.features, spec, root)
+        check_features(lerobot_meta.features, spec, root, "--inputs")
         if lerobot_meta.total_episodes == 0:
             raise ConfigError(f"cannot merge {root}: it holds no episodes")
         metas.append(info.meta)
@@ -119,7 +118,9 @@ def merge_datasets(
 
 def run_merge(cfg: MergeConfig) -> Path:
     """``igen-merge``: check every input belongs to the task, then aggregate them (atomically)."""
-    spec = task_config_class(cfg.task)().task_spec
+    spec = dataset_spec(Path(cfg.inputs[0]), "--inputs")
+    if spec.name != cfg.task:
+        raise TaskMismatchError(f"--inputs[0]={cfg.inputs[0]} holds task {spec.name!r}, not --task={cfg.task}")
     repo_id, root = cfg.dataset.resolve(Path(cfg.dataset.root).name)
     merged = merge_datasets(
         [Path(p) for p in cfg.inputs], root, repo_id, spec, overwrite=cfg.dataset.overwrite, weights=cfg.weights

@@ -40,11 +40,13 @@ class DatasetInfo:
     meta: dict
 
 
-def read_igen_meta(root: Path) -> DatasetInfo:
-    """The task and provenance recorded in ``meta/igen.json``."""
+def read_igen_meta(root: Path, flag: str = "--dataset.root") -> DatasetInfo:
+    """The task and provenance recorded in ``meta/igen.json``; ``flag`` is the option that named ``root``."""
     root = Path(root)
     if not (root / "meta" / "info.json").exists():
-        raise DatasetSchemaError(f"{root} is not a LeRobot dataset (meta/info.json missing); check --dataset.root")
+        partial = root.with_name(root.name + ".partial")
+        hint = f" ({partial} holds an unfinished run: rerun its command to complete it)" if partial.exists() else ""
+        raise DatasetSchemaError(f"{root} is not a LeRobot dataset (meta/info.json missing){hint}; check {flag}")
     path = root / IGEN_META_FILE
     if not path.exists():
         raise DatasetSchemaError(
@@ -55,18 +57,49 @@ def read_igen_meta(root: Path) -> DatasetInfo:
     return DatasetInfo(root=root, task=meta["task"], meta=meta)
 
 
-def check_features(features: dict[str, dict], spec: TaskSpec, root: Path) -> None:
-    """Every igen column present with the shape ``spec`` needs."""
+def dataset_spec(root: Path, flag: str = "--dataset.root") -> TaskSpec:
+    """The task spec a dataset was written under (its task, and the reveal mode its observation layout shows)."""
+    from igen_lerobot.core.belief import Reveal
+    from igen_lerobot.core.env_config import task_config_class
+
+    root = Path(root)
+    info = read_igen_meta(root, flag)
+    base = task_config_class(info.task).base_spec
+    features = json.loads((root / "meta" / "info.json").read_text())["features"]
+    names = tuple(features.get(OBS_ENV_STATE, {}).get("names") or ())
+    candidates = [base.with_reveal(r) for r in Reveal if base.reveal_contact is not None or r is Reveal.NONE]
+    for spec in candidates:
+        if spec.env_state_names == names:
+            return spec
+    raise DatasetSchemaError(
+        f"{root} ({flag}): its {OBS_ENV_STATE} names {names} fit no layout of task {info.task!r} "
+        f"(e.g. {base.env_state_names}); was it written by another version of the task?"
+    )
+
+
+def check_features(features: dict[str, dict], spec: TaskSpec, root: Path, flag: str = "--dataset.root") -> None:
+    """Every igen column present with the shape (and, for observations, the names) ``spec`` needs."""
     expected = dataset_features(spec)
     for key in (OBS_STATE, OBS_ENV_STATE, ACTION, *IGEN_COLUMNS):
         if key not in features:
             raise DatasetSchemaError(
-                f"{root}: feature {key!r} is missing; igen datasets carry {sorted(expected)} "
+                f"{flag}={root}: feature {key!r} is missing; igen datasets carry {sorted(expected)} "
                 "(see README, 'Dataset schema')"
             )
         got, want = tuple(features[key]["shape"]), tuple(expected[key]["shape"])
         if got != want:
-            raise DatasetSchemaError(f"{root}: feature {key!r} has shape {got}, task {spec.name!r} needs {want}")
+            raise DatasetSchemaError(
+                f"{flag}={root}: feature {key!r} has shape {got}, task {spec.name!r} needs {want}"
+                + _layout_hint(key, features[key].get("names"), expected[key]["names"])
+            )
+
+
+def _layout_hint(key: str, got: list | None, want: list | None) -> str:
+    if key == OBS_ENV_STATE and got and want and any(n.endswith(".dir.x") for n in (*got, *want)):
+        return " (the reveal mode changes this layout: use the --env.reveal the dataset was made with)"
+    if key == ACTION:
+        return " (a dataset of another action space: another task, or another version of this one)"
+    return ""
 
 
 def _column_array(column) -> np.ndarray:
@@ -78,19 +111,27 @@ def _column_array(column) -> np.ndarray:
 
 
 def load_episodes(
-    root: Path, spec: TaskSpec, repo_id: str | None = None, episodes: list[int] | None = None
+    root: Path,
+    spec: TaskSpec,
+    repo_id: str | None = None,
+    episodes: list[int] | None = None,
+    flag: str = "--dataset.root",
 ) -> list[Episode]:
-    """All (or the listed) episodes of the igen dataset at ``root`` as :class:`Episode` objects."""
+    """All (or the listed) episodes of the igen dataset at ``root`` as :class:`Episode` objects.
+
+    ``flag`` is the command-line option that named ``root``, so errors point at what to change.
+    """
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     root = Path(root)
-    info = read_igen_meta(root)
+    info = read_igen_meta(root, flag)
     if info.task != spec.name:
         raise TaskMismatchError(
-            f"{root} holds task {info.task!r}, not {spec.name!r}; pass a {spec.name} dataset or --task={info.task}"
+            f"{flag}={root} holds task {info.task!r}, not {spec.name!r}; pass a {spec.name} dataset "
+            f"or --env.type={info.task}"
         )
     dataset = LeRobotDataset(repo_id or f"local/{root.name}", root=root, episodes=episodes)
-    check_features(dataset.meta.features, spec, root)
+    check_features(dataset.meta.features, spec, root, flag)
     # Arrow columns, converted once: datasets' numpy formatting takes ~10 s per column at 60k frames.
     table = dataset.hf_dataset.with_format("arrow")
     columns = {

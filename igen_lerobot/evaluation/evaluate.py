@@ -7,7 +7,6 @@ import json
 import logging
 from pathlib import Path
 
-from igen_lerobot.core.error_models import PoseNoise
 from igen_lerobot.evaluation.checkpoints import best_result, list_checkpoints
 from igen_lerobot.evaluation.config_eval import EvalConfig
 from igen_lerobot.evaluation.trials import EvalResult, evaluate
@@ -74,7 +73,7 @@ def run_eval(cfg: EvalConfig) -> dict:
         "n_trials": cfg.n_trials,
         "seed": cfg.seed,
         "corruption": {
-            "type": PoseNoise.get_choice_name(type(env_cfg.corruption)),
+            "type": env_cfg.corruption.type_name,
             **dataclasses.asdict(env_cfg.corruption),
         },
         "reveal": str(env_cfg.reveal),

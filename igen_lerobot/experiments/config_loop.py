@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.generation.intervengen import IntervenGenConfig
-from igen_lerobot.training.lerobot_train import TrainConfig
+from igen_lerobot.training.config_train import TrainConfig
 
 
 @dataclass

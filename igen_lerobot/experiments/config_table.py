@@ -4,21 +4,25 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.core.belief import Reveal
+from igen_lerobot.core.env_config import TaskEnvConfig, task_config_class
 from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.paper import VARIANTS
 from igen_lerobot.evaluation.config_eval import EVAL_SEED
-from igen_lerobot.training.lerobot_train import TrainConfig
-
-# The rows of the paper's Block Grasp table, in its order.
-VARIANTS = ("base", "source_int", "weighted_src_int", "source_demo", "mg_demo", "igen_no_policy", "igen")
+from igen_lerobot.training.config_train import TrainConfig
 
 
 @dataclass
 class TableConfig:
-    """Sizes follow the paper (10 source episodes, 1000 generated, 50 trials); shrink them for a smoke run."""
+    """Sizes follow the paper (10 source episodes, 1000 generated, 50 trials); shrink them for a smoke run.
+
+    ``--reveal`` picks the observability (default: the task's own, the paper's main table); the
+    rows default to the paper's rows for that table.
+    """
 
     task: str = "block_grasp"
-    variants: list[str] = field(default_factory=lambda: list(VARIANTS))
+    reveal: str | None = None  # e.g. contact_position for the paper's partial-observability table
+    variants: list[str] | None = None  # default: the rows of the paper's table for this task and reveal mode
     source_episodes: int = 10  # human (here: scripted-operator) episodes of each kind
     base_demos: int = 1000  # MimicGen demonstrations forming the base dataset D
     generated: int = 1000  # synthetic episodes for MG Demo, I-Gen - Policy and I-Gen
@@ -29,13 +33,18 @@ class TableConfig:
     n_trials: int = 50
     eval_seed: int = EVAL_SEED
     output_dir: str = "outputs/table"
-    results: str = "docs/results.md"  # the markdown table; the JSON goes next to it (.json)
+    # the markdown page of every table; each table's JSON (and an optional <name>.notes.md with a reading
+    # of it) lives in the folder of the same name (docs/results/), and the page is rendered from all of them
+    results: str = "docs/results.md"
     # run each command inside this process (same arguments, same code, recorded the same) instead of
     # a subprocess: saves the ~20 s of imports per command that dominate small smoke runs
     in_process: bool = False
 
     def __post_init__(self) -> None:
-        task_config_class(self.task)
+        env = self.env_config()
+        if self.variants is None:
+            table = env.paper_table()
+            self.variants = list(table.rows) if table is not None else list(VARIANTS)
         unknown = [v for v in self.variants if v not in VARIANTS]
         if unknown or not self.variants:
             raise ConfigError(f"--variants must be a non-empty subset of {list(VARIANTS)}, got {self.variants}")
@@ -44,3 +53,22 @@ class TableConfig:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")
+
+    def env_config(self) -> TaskEnvConfig:
+        """The task's config under this table's reveal mode (checked: a clear error for a bad one)."""
+        cls = task_config_class(self.task)
+        if self.reveal is None:
+            return cls()
+        try:
+            reveal = Reveal(self.reveal)
+        except ValueError:
+            modes = [r.value for r in Reveal]
+            raise ConfigError(f"--reveal={self.reveal!r} is not a reveal mode; use one of {modes}") from None
+        return cls(reveal=reveal)
+
+    @property
+    def name(self) -> str:
+        """The table's name in the results folder: the task, and the reveal mode unless it is the task's default."""
+        default = task_config_class(self.task)().reveal
+        reveal = self.env_config().reveal
+        return self.task if reveal is default else f"{self.task}_{reveal.value}"

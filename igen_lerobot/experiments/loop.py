@@ -23,6 +23,7 @@ from igen_lerobot.collection.config_collect import CollectConfig
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
 from igen_lerobot.datasets.merge import merge_datasets
+from igen_lerobot.datasets.reader import dataset_spec
 from igen_lerobot.experiments.config_loop import LoopConfig
 from igen_lerobot.generation.config_generate import GenerateConfig, SourceDatasetConfig
 from igen_lerobot.generation.generate import generate
@@ -75,7 +76,7 @@ def run_loop(cfg: LoopConfig) -> dict:
             )
         merged = step_dir / "dataset"
         if not _complete(merged):
-            spec = task_config_class(cfg.task)().task_spec
+            spec = dataset_spec(dataset, "--base_dataset")
             merge_datasets([dataset, generated], merged, f"local/iter{i}_dataset", spec)
         produced["iterations"].append(
             {

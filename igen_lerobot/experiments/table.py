@@ -42,8 +42,6 @@ LABELS = {
     "igen_no_policy": "I-Gen − Policy",
     "igen": "I-Gen",
 }
-# IntervenGen paper, sim-to-real table, Block Grasp in simulation (50 trials); rows it does not report are absent.
-PAPER_SIM_SUCCESS = {"block_grasp": {"base": 6, "source_int": 26, "mg_demo": 42, "igen_no_policy": 86, "igen": 100}}
 # what each variant adds to the base dataset D (None: D alone), and with which weights
 VARIANT_PART = {
     "base": None,
@@ -130,10 +128,15 @@ def _complete(root: Path) -> Path:
     return root / "meta" / "igen.json"
 
 
+def env_args(cfg: TableConfig) -> list[str]:
+    """The task (and reveal mode) every collect/generate/eval command of the table runs under."""
+    return [f"--env.type={cfg.task}", *([f"--env.reveal={cfg.reveal}"] if cfg.reveal is not None else [])]
+
+
 def build_datasets(run: TableRun) -> dict[str, Path]:
     """Collect, generate and merge everything the chosen variants need; returns their training datasets."""
-    cfg, task = run.cfg, f"--task={run.cfg.task}"
-    env = f"--env.type={cfg.task}"
+    cfg = run.cfg
+    env = env_args(cfg)
     needs = {VARIANT_PART[v] for v in cfg.variants} - {None}
     n_src, workers = str(cfg.source_episodes), f"--workers={cfg.workers}"
 
@@ -141,7 +144,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
         "source_demos",
         run.igen(
             "igen-collect",
-            env,
+            *env,
             "--mode=demos",
             f"--num_episodes={n_src}",
             f"--seed={cfg.seed}",
@@ -154,7 +157,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
         run.igen(
             "igen-generate",
             "--mode=mimicgen",
-            task,
+            *env,
             f"--source.root={run.data('source_demos')}",
             f"--num_episodes={cfg.base_demos}",
             f"--seed={cfg.seed}",
@@ -170,7 +173,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
             "source_int",
             run.igen(
                 "igen-collect",
-                env,
+                *env,
                 "--mode=interventions",
                 f"--num_episodes={n_src}",
                 f"--seed={cfg.seed + 1}",
@@ -184,7 +187,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
             "test_demos",
             run.igen(
                 "igen-collect",
-                env,
+                *env,
                 "--mode=demos",
                 "--demo_observation=corrupted",
                 f"--num_episodes={n_src}",
@@ -200,7 +203,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
                 "igen-generate",
                 "--mode=mimicgen",
                 "--demo_observation=corrupted",
-                task,
+                *env,
                 f"--source.root={run.data('test_demos')}",
                 f"--num_episodes={cfg.generated}",
                 f"--seed={cfg.seed + 3}",
@@ -216,7 +219,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
                 run.igen(
                     "igen-generate",
                     f"--mode={mode}",
-                    task,
+                    *env,
                     f"--source.root={run.data('source_int')}",
                     f"--num_episodes={cfg.generated}",
                     f"--seed={cfg.seed + 4}",
@@ -238,7 +241,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
             f"merge_{variant}",
             run.igen(
                 "igen-merge",
-                task,
+                f"--task={cfg.task}",
                 f"--inputs=[{run.data('base')},{run.data(part)}]",
                 *weights,
                 f"--dataset.root={merged}",
@@ -266,7 +269,7 @@ def evaluate_variant(run: TableRun, variant: str) -> dict:
         f"eval_{variant}",
         run.igen(
             "igen-eval",
-            f"--task={cfg.task}",
+            *env_args(cfg),
             f"--train_dir={run.out / 'train' / variant}",
             f"--every={cfg.eval_every}",
             f"--n_trials={cfg.n_trials}",
@@ -285,9 +288,11 @@ def _dataset_size(root: Path) -> dict:
 
 
 def run_table(cfg: TableConfig) -> dict:
-    """Build, train and evaluate every variant; write the markdown table and its JSON."""
+    """Build, train and evaluate every variant; write the table's JSON and re-render the results page."""
     run = TableRun(cfg)
     start = time.perf_counter()
+    env = cfg.env_config()
+    paper = env.paper_table()
     datasets = build_datasets(run)
     rows = []
     for variant in cfg.variants:
@@ -304,12 +309,14 @@ def run_table(cfg: TableConfig) -> dict:
                 "best_step": best["step"],
                 "trials": best["trials"],
                 "per_checkpoint": {r["step"]: r["success_rate"] for r in report["results"]},
-                "paper": PAPER_SIM_SUCCESS.get(cfg.task, {}).get(variant),
+                "paper": None if paper is None else paper.success.get(variant),
                 "dataset": _dataset_size(datasets[variant]),
             }
         )
     result = {
         "task": cfg.task,
+        "name": cfg.name,
+        "reveal": env.reveal.value,
         "config": asdict(cfg),
         "rows": rows,
         "commands": run.commands,
@@ -317,26 +324,65 @@ def run_table(cfg: TableConfig) -> dict:
         "step_times_s": run.timings,
     }
     results = Path(cfg.results)
-    results.parent.mkdir(parents=True, exist_ok=True)
-    results.with_suffix(".json").write_text(json.dumps(result, indent=2))
-    results.write_text(render_markdown(result))
+    folder = results_folder(results)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
+    results.write_text(render_page(load_results(folder)))
     return result
+
+
+def results_folder(results_md: Path) -> Path:
+    """Where the tables behind a results page live: ``docs/results.md`` -> ``docs/results/``."""
+    return Path(results_md).with_suffix("")
+
+
+def load_results(folder: Path) -> list[tuple[dict, str]]:
+    """Every table JSON in ``folder`` with its hand-written reading (``<name>.notes.md``, may be empty)."""
+    tables = []
+    for path in sorted(Path(folder).glob("*.json")):
+        notes = path.with_name(path.stem + ".notes.md")
+        tables.append((json.loads(path.read_text()), notes.read_text() if notes.exists() else ""))
+    return tables
 
 
 def _which_checkpoints(k: int) -> str:
     return "every saved checkpoint" if k == 1 else f"one in every {k} saved checkpoints"
 
 
-def render_markdown(result: dict) -> str:
-    """The table, the protocol and the commands, for ``docs/results.md``."""
+def _title(result: dict) -> str:
+    task = result["task"].replace("_", " ").title()
+    reveal = result.get("reveal", "full")
+    observability = {
+        "full": "full observability on contact",
+        "none": "nothing revealed",
+        "contact_position": "partial observability: first contact position",
+        "direction": "partial observability: direction to the true pose",
+    }.get(reveal, reveal)
+    return f"{task} ({observability})"
+
+
+def render_page(tables: list[tuple[dict, str]]) -> str:
+    """The results page: one section per table (``docs/results.md``)."""
+    lines = [
+        "# Results",
+        "",
+        "Success rate of the best evaluated checkpoint over seeded trials under the task's observation",
+        "error, with a 95% Wilson interval; within a table every variant is trained with the same",
+        "`lerobot-train` settings on the base dataset D plus its own part. Produced by `igen-table`; the",
+        "JSON of each table (`docs/results/<table>.json`) holds the same numbers, per-checkpoint rates and",
+        "the config, and this page is rendered from those files.",
+        "",
+    ]
+    for result, notes in tables:
+        lines += render_markdown(result, notes)
+    return "\n".join(lines)
+
+
+def render_markdown(result: dict, notes: str = "") -> list[str]:
+    """One table's section: the table, a reading of it, the protocol and the commands."""
     cfg = result["config"]
     lines = [
-        f"# Results: {result['task']}",
-        "",
-        "Success rate of the best evaluated checkpoint over seeded trials under the task's pose error",
-        "(revealed on contact), with a 95% Wilson interval; every variant is trained with the same",
-        "`lerobot-train` settings on the base dataset D plus its own part. Produced by `igen-table`;",
-        "the JSON next to this file holds the same numbers, per-checkpoint rates and the config.",
+        f"## {_title(result)}",
         "",
         "| Variant | ours | 95% CI | best step | paper (sim) | training data |",
         "|---|---|---|---|---|---|",
@@ -349,10 +395,12 @@ def render_markdown(result: dict) -> str:
             f"| {row['label']} | {100 * row['success_rate']:.0f}% ({row['trials']} trials) | "
             f"{100 * low:.0f}–{100 * high:.0f}% | {row['best_step']} | {paper} | {data} |"
         )
+    if notes.strip():
+        lines += ["", notes.strip()]
     train = cfg["train"]
     lines += [
         "",
-        "## Protocol",
+        "Protocol:",
         "",
         f"- {cfg['source_episodes']} source episodes of each kind (scripted operator), "
         f"{cfg['base_demos']} MimicGen demonstrations in D, "
@@ -366,14 +414,14 @@ def render_markdown(result: dict) -> str:
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
         "",
-        "## Commands",
+        "Commands:",
         "",
         "```bash",
         *[c["command"] for c in result["commands"]],
         "```",
         "",
     ]
-    return "\n".join(lines)
+    return lines
 
 
 def table_command(cfg: TableConfig) -> dict:
@@ -381,5 +429,5 @@ def table_command(cfg: TableConfig) -> dict:
     result = run_table(cfg)
     for row in result["rows"]:
         print(f"{row['label']:>18}: {100 * row['success_rate']:5.1f}%  (paper: {row['paper']})")
-    print(f"Wrote {cfg.results} and its JSON")
+    print(f"Wrote {cfg.results} and {results_folder(Path(cfg.results)) / (cfg.name + '.json')}")
     return result

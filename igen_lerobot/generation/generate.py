@@ -59,7 +59,7 @@ def generate(cfg: GenerateConfig) -> None:
         env_cfg = dataclasses.replace(env_cfg, corruption=NoNoise())
     spec = env_cfg.task_spec
     source_root = Path(cfg.source.root)
-    episodes = load_episodes(source_root, spec, repo_id=cfg.source.repo_id)
+    episodes = load_episodes(source_root, spec, repo_id=cfg.source.repo_id, flag="--source.root")
     probe = env_cfg.make_task_env()  # only its action <-> target conversion is used here
     parse = parse_demos if mode is GenerationMode.MIMICGEN else parse_interventions
     library = parse(episodes, spec, probe.target_pose_from_action, probe.gripper_command)

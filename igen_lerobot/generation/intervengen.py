@@ -1,8 +1,9 @@
 """IntervenGen (Algorithm 1): a new intervention from a policy mistake and a replayed recovery.
 
 In the scene and pose error of ``seed`` the policy acts on its corrupted observation until it
-makes a mistake, detected by contact with the current subtask's object (or until a step budget
-runs out). A source recovery for that subtask is moved to the object's true pose, bridged to by
+makes a mistake, detected by the task's own mistake signal (``StepInfo.mistake``: the contact
+that reveals the error, or for Nut-and-Peg a grasp that closes on air), or until a step budget
+runs out. A source recovery for that subtask is moved to the object's true pose, bridged to by
 interpolation and replayed open loop. Control returns to the policy afterwards, so a subtask
 may see zero, one or several mistake/recovery alternations. The episode is kept only if the task
 succeeds, and only its frames from the first mistake on (``xi[t:]``) are stored, recovery frames
@@ -10,7 +11,7 @@ flagged as intervention.
 
 Ablation "I-Gen - Policy" (``mistakes="replay"``): instead of running the policy, a source
 mistake is replayed (moved to the new object pose, under that source's pose error) until it
-touches the object; the rest is the same.
+makes its mistake; the rest is the same.
 """
 
 from __future__ import annotations
@@ -57,14 +58,12 @@ class IntervenGenConfig:
             raise ConfigError(f"igen.max_recoveries must be >= 1, got {self.max_recoveries}")
 
 
-def _run_policy_until_mistake(
-    env: TaskEnv, policy: Policy, recorder: EpisodeRecorder, obs: dict, budget: int, revealed: bool
-):
+def _run_policy_until_mistake(env: TaskEnv, policy: Policy, recorder: EpisodeRecorder, obs: dict, budget: int):
     """Policy steps until a mistake, success, a finished subtask, or the budget.
 
-    A mistake is the contact that reveals the pose error (the robot touches the object where it
-    did not believe it was). Contacts once the pose is known are the policy manipulating the
-    object, not mistakes: after a recovery the policy may grasp without triggering another one.
+    The mistake is the task's signal (``StepInfo.mistake``). Contacts once the pose is known are
+    the policy manipulating the object, not mistakes: after a recovery the policy may grasp
+    without triggering another one.
     """
     subtask = env.subtask_index()
     for step in range(budget):
@@ -73,13 +72,12 @@ def _run_policy_until_mistake(
         info = env.step(action)
         obs = env.observe()
         if info.success:
-            return obs, "success", step + 1, info.revealed
-        if info.contact and not revealed:
-            return obs, "mistake", step + 1, info.revealed
-        revealed = info.revealed
+            return obs, "success", step + 1
+        if info.mistake:
+            return obs, "mistake", step + 1
         if env.subtask_index() != subtask:
-            return obs, "subtask_done", step + 1, revealed
-    return obs, "budget", budget, revealed
+            return obs, "subtask_done", step + 1
+    return obs, "budget", budget
 
 
 def generate_intervention(
@@ -110,7 +108,7 @@ def generate_intervention(
         policy.reset()
     first_mistake: int | None = None
     recoveries: list[int] = []
-    success, steps, revealed = False, 0, False
+    success, steps = False, 0
     while steps < max_steps and not success:
         subtask = min(env.subtask_index(), len(env.spec.subtasks) - 1)
         if replayed_mistake is not None:
@@ -123,19 +121,18 @@ def generate_intervention(
                 rng,
                 flagged=False,
                 max_steps=min(cfg.mistake_budget, max_steps - steps),
-                stop_on_contact=True,
+                stop_on_mistake=True,
             )
             obs, steps = outcome.obs, steps + outcome.steps
             success = bool(outcome.info and outcome.info.success)
-            revealed = bool(outcome.info and outcome.info.revealed)
             why = "success" if success else "mistake"
             replayed_mistake = None  # one replayed mistake, then recoveries (as the source had)
         else:
             if policy is None:  # ablation after its replayed mistake: another recovery, no policy
                 why = "budget"
             else:
-                obs, why, n, revealed = _run_policy_until_mistake(
-                    env, policy, recorder, obs, min(cfg.mistake_budget, max_steps - steps), revealed
+                obs, why, n = _run_policy_until_mistake(
+                    env, policy, recorder, obs, min(cfg.mistake_budget, max_steps - steps)
                 )
                 steps += n
                 success = why == "success"
@@ -156,7 +153,6 @@ def generate_intervention(
         )
         obs, steps = outcome.obs, steps + outcome.steps
         success = bool(outcome.info and outcome.info.success)
-        revealed = revealed or bool(outcome.info and outcome.info.revealed)
         if policy is not None:
             policy.reset()
     details = {"recoveries": recoveries, "mistake_step": first_mistake}

@@ -4,6 +4,11 @@ MimicGen's recipe: transform the segment's end-effector goals so they keep their
 the object (``T_new_eef = T_new_obj · inv(T_src_obj) · T_src_eef``), bridge from where the
 robot is to the first transformed goal with a linear/slerp interpolation, then execute the
 goals one per control step with the recorded gripper commands.
+
+The bridge is long enough for both its distance and its rotation; target noise (MimicGen's
+action noise) perturbs positions and orientations; a segment that ends before its subtask is
+done holds its last goal for a few steps, but never once the subtask is done, so a multi-stage
+episode flows from one subtask into the next without idling.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from igen_lerobot.core.exceptions import ConfigError
-from igen_lerobot.core.geometry import interpolate_poses, transform_segment
+from igen_lerobot.core.geometry import interpolate_poses, matrix_from_rotvec, rotation_angle, transform_segment
 from igen_lerobot.core.recorder import EpisodeRecorder
 from igen_lerobot.core.task import FrameSource, StepInfo, TaskEnv
 from igen_lerobot.generation.sources import SourceSegment
@@ -25,22 +30,42 @@ class ReplayConfig:
 
     interpolation_steps: int = 5  # minimum control steps bridging the current pose and the segment's start
     interpolation_speed: float = 0.015  # [m per step] longer bridges get more steps, so the arm can follow
+    interpolation_rotation_speed: float = 0.1  # [rad per step] bridges that turn further get more steps too
     target_noise: float = 0.0  # [m] std of Gaussian noise on replayed goal positions (MimicGen's action noise)
-    hold_steps: int = 10  # extra steps holding the last goal while the task is not done yet
+    target_rotation_noise: float = 0.0  # [rad] std of the noise rotation on replayed goal orientations
+    hold_steps: int = 10  # extra steps holding the last goal while the segment's subtask is not done yet
 
     def __post_init__(self) -> None:
         if self.interpolation_steps < 1:
             raise ConfigError(f"replay.interpolation_steps must be >= 1, got {self.interpolation_steps}")
         if self.interpolation_speed <= 0:
             raise ConfigError(f"replay.interpolation_speed must be > 0 [m per step], got {self.interpolation_speed}")
-
-    def bridge_steps(self, distance: float) -> int:
-        """Steps for a bridge of ``distance`` [m]: at least ``interpolation_steps``."""
-        return max(self.interpolation_steps, int(np.ceil(distance / self.interpolation_speed)))
+        if self.interpolation_rotation_speed <= 0:
+            speed = self.interpolation_rotation_speed
+            raise ConfigError(f"replay.interpolation_rotation_speed must be > 0 [rad per step], got {speed}")
         if self.target_noise < 0:
             raise ConfigError(f"replay.target_noise must be >= 0 [m], got {self.target_noise}")
+        if self.target_rotation_noise < 0:
+            raise ConfigError(f"replay.target_rotation_noise must be >= 0 [rad], got {self.target_rotation_noise}")
         if self.hold_steps < 0:
             raise ConfigError(f"replay.hold_steps must be >= 0, got {self.hold_steps}")
+
+    def bridge_steps(self, distance: float, angle: float = 0.0) -> int:
+        """Steps for a bridge of ``distance`` [m] turning by ``angle`` [rad]: at least ``interpolation_steps``."""
+        by_distance = int(np.ceil(distance / self.interpolation_speed))
+        by_angle = int(np.ceil(angle / self.interpolation_rotation_speed))
+        return max(self.interpolation_steps, by_distance, by_angle)
+
+    def perturb(self, goal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """``goal`` with this config's position and orientation noise (unchanged when both are 0)."""
+        if self.target_noise <= 0 and self.target_rotation_noise <= 0:
+            return goal
+        goal = goal.copy()
+        if self.target_noise > 0:
+            goal[:3, 3] += rng.normal(0.0, self.target_noise, 3)
+        if self.target_rotation_noise > 0:
+            goal[:3, :3] = matrix_from_rotvec(rng.normal(0.0, self.target_rotation_noise, 3)) @ goal[:3, :3]
+        return goal
 
 
 @dataclass
@@ -63,18 +88,20 @@ def replay_segment(
     rng: np.random.Generator,
     flagged: bool,
     max_steps: int,
-    stop_on_contact: bool = False,
+    stop_on_mistake: bool = False,
 ) -> ReplayOutcome:
     """Execute ``segment`` relative to its object's current true pose, recording every frame.
 
-    Stops early on task success, on ``max_steps``, or (``stop_on_contact``) when the gripper
-    touches the subtask's object (used when a replayed mistake stands in for the policy).
+    Stops early on task success, on ``max_steps``, or (``stop_on_mistake``) on the task's mistake
+    signal (used when a replayed mistake stands in for the policy). The hold after the segment
+    ends as soon as the segment's subtask is done.
     """
     T_world_obj = env.true_object_poses()[segment.object_name]
     transformed = transform_segment(segment.targets, segment.T_world_obj, T_world_obj)
     T_world_eef = env.eef_pose()
     distance = float(np.linalg.norm(transformed[0][:3, 3] - T_world_eef[:3, 3]))
-    bridge = interpolate_poses(T_world_eef, transformed[0], cfg.bridge_steps(distance))
+    angle = rotation_angle(T_world_eef[:3, :3], transformed[0][:3, :3])
+    bridge = interpolate_poses(T_world_eef, transformed[0], cfg.bridge_steps(distance, angle))
     hold = np.repeat(transformed[-1:], cfg.hold_steps, axis=0)
     goals = np.concatenate([bridge, transformed, hold])
     gripper = np.concatenate(
@@ -85,19 +112,19 @@ def replay_segment(
         ]
     )
     sources = [FrameSource.INTERPOLATION] * len(bridge) + [FrameSource.GENERATED] * (len(transformed) + len(hold))
+    holding_from = len(bridge) + len(transformed)
     info: StepInfo | None = None
     steps = 0
-    for goal, closed, source in zip(goals, gripper, sources, strict=True):
+    for index, (goal, closed, source) in enumerate(zip(goals, gripper, sources, strict=True)):
         if steps >= max_steps:
             break
-        if cfg.target_noise > 0:
-            goal = goal.copy()
-            goal[:3, 3] += rng.normal(0.0, cfg.target_noise, 3)
-        action = env.action_towards(goal, bool(closed))
+        if index >= holding_from and env.subtask_index() > segment.subtask:
+            break  # the subtask is done: go on with the next one instead of idling
+        action = env.action_towards(cfg.perturb(goal, rng), bool(closed))
         recorder.record(obs, action, source, flagged)
         info = env.step(action)
         obs = env.observe()
         steps += 1
-        if info.success or (stop_on_contact and info.contact):
+        if info.success or (stop_on_mistake and info.mistake):
             break
     return ReplayOutcome(obs=obs, info=info, steps=steps, transformed=transformed, interpolation=bridge)

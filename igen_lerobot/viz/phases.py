@@ -21,8 +21,6 @@ import numpy as np
 
 from igen_lerobot.core.task import FrameSource
 
-REVEALED_INDEX = -1  # observation.environment_state ends with the latched ``revealed`` flag
-
 
 class Phase(enum.IntEnum):
     """A frame's role; stored as ints, coloured by ``PHASE_COLORS``."""
@@ -54,11 +52,14 @@ PHASE_LABELS = {
 RECOVERY_PHASES = (Phase.OPERATOR, Phase.GENERATED, Phase.INTERPOLATION)
 
 
-def frame_phases(source: np.ndarray, flagged: np.ndarray, env_state: np.ndarray) -> np.ndarray:
-    """Phase (int) of every frame from ``frame_source``, ``is_intervention`` and the observation's ``revealed``."""
+def frame_phases(source: np.ndarray, flagged: np.ndarray, revealed: np.ndarray) -> np.ndarray:
+    """Phase (int) of every frame from ``frame_source``, ``is_intervention`` and the latched ``revealed``.
+
+    ``revealed`` comes from the observation (:meth:`~igen_lerobot.core.task.TaskSpec.revealed_flags`).
+    """
     source = np.asarray(source).reshape(-1)
     flagged = np.asarray(flagged, dtype=bool).reshape(-1)
-    revealed = np.asarray(env_state)[:, REVEALED_INDEX] > 0.5
+    revealed = np.asarray(revealed, dtype=bool).reshape(-1)
     policy = source == FrameSource.POLICY
     phases = np.full(source.shape, int(Phase.DEMO))
     phases[policy] = Phase.POLICY

@@ -18,21 +18,25 @@ import numpy as np
 from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_phases
 
 
-def draw_episode(episode, output: Path, title: str, half: float = 0.025) -> None:
-    """Render ``episode`` (an :class:`~igen_lerobot.core.episode.Episode`) to a PNG."""
+def draw_episode(episode, spec, output: Path, title: str) -> None:
+    """Render ``episode`` (an :class:`~igen_lerobot.core.episode.Episode` of task ``spec``) to a PNG."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.patches import Rectangle
 
-    phases = frame_phases(episode.source, episode.is_intervention, episode.env_state)
+    revealed_flags = spec.revealed_flags(episode.env_state)
+    phases = frame_phases(episode.source, episode.is_intervention, revealed_flags)
     eef = episode.state[:, :3]
     colors = np.array([PHASE_COLORS[Phase(int(p))] for p in phases]) / 255.0
     fig, (top, side) = plt.subplots(1, 2, figsize=(11, 4.6), gridspec_kw={"width_ratios": [1, 1.4]})
-    true = episode.true_object_pose[0, :3]
-    believed = true + episode.corruption[:3]  # where the robot believed the cube until it touched it
-    boxes = ((believed, "#db4437", "--", "believed cube"), (true, "#0f9d58", "-", "true cube"))
+    k = spec.objects.index(spec.corrupted_object)
+    true = episode.true_object_pose[0, 7 * k : 7 * k + 3]
+    believed = episode.env_state[0, 7 * k : 7 * k + 3]  # where the robot believed it until the reveal
+    half = spec.box(spec.corrupted_object).half_size[0]
+    obj = spec.corrupted_object
+    boxes = ((believed, "#db4437", "--", f"believed {obj}"), (true, "#0f9d58", "-", f"true {obj}"))
     for centre, color, style, label in boxes:
         top.add_patch(
             Rectangle(centre[:2] - half, 2 * half, 2 * half, fill=False, ec=color, ls=style, lw=2, label=label)
@@ -48,7 +52,7 @@ def draw_episode(episode, output: Path, title: str, half: float = 0.025) -> None
     side.scatter(steps, eef[:, 2], c=colors, s=10)
     side.set_xlabel("frame (20 Hz)")
     side.set_ylabel("hand height z [m]")
-    revealed = np.flatnonzero(episode.env_state[:, -1] > 0.5)
+    revealed = np.flatnonzero(revealed_flags)
     if len(revealed):
         side.axvline(revealed[0], color="#db4437", ls=":", lw=1)
         side.text(revealed[0], eef[:, 2].max(), " first contact", color="#db4437", fontsize=8, va="top")
@@ -75,17 +79,16 @@ def main() -> None:
     parser.add_argument("--output", default="docs/images/intervention_episode.png")
     args = parser.parse_args()
 
-    from igen_lerobot.core.env_config import task_config_class
-    from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
+    from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 
-    spec = task_config_class(read_igen_meta(Path(args.root)).task)().task_spec
+    spec = dataset_spec(Path(args.root), "--root")
     (episode,) = load_episodes(Path(args.root), spec, episodes=[args.episode])
     outcome = "success" if episode.success else "failure"
     title = (
         f"{spec.name}: {episode.kind} episode {args.episode} ({outcome}); pose error "
         f"{np.round(100 * episode.corruption, 1).tolist()} cm, {int(episode.is_intervention.sum())} flagged frames"
     )
-    draw_episode(episode, Path(args.output), title)
+    draw_episode(episode, spec, Path(args.output), title)
     print(f"wrote {args.output}")
 
 

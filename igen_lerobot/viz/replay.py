@@ -8,8 +8,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from igen_lerobot.core.env_config import task_config_class
-from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
+from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 from igen_lerobot.viz.config_viz import VizConfig
 from igen_lerobot.viz.rerun_log import EpisodeLogger, RerunConfig
 
@@ -21,8 +20,7 @@ def replay_dataset(
 ) -> dict:
     """Log the listed (default: all) episodes of the dataset at ``root``; returns counts and seconds."""
     start = time.perf_counter()
-    info = read_igen_meta(Path(root))
-    spec = task_config_class(info.task)().task_spec
+    spec = dataset_spec(Path(root))
     loaded = load_episodes(Path(root), spec, repo_id=repo_id, episodes=episodes)
     log = EpisodeLogger.open(rerun, spec, f"replay/{Path(root).name}")
     if log is None:

@@ -103,7 +103,8 @@ class EpisodeLogger:
         root = f"episodes/{index}"
         n = len(state)
         frames = rr.TimeColumn(FRAME, sequence=np.arange(n))
-        phases = frame_phases(source, flagged, env_state)
+        revealed = self.spec.revealed_flags(env_state)
+        phases = frame_phases(source, flagged, revealed)
         eef = np.asarray(state, dtype=np.float32)[:, :3]
         stream.log(f"{root}/path", rr.Points3D(eef, colors=phase_colors(phases), radii=0.002), static=True)
         stream.log(
@@ -128,14 +129,13 @@ class EpisodeLogger:
             columns=rr.Points3D.columns(positions=eef, colors=phase_colors(phases), radii=np.full(n, 0.008)),
         )
         for k, obj in enumerate(self.spec.objects):
-            believed = np.asarray(env_state, dtype=np.float32)[:, 7 * k : 7 * k + 3]
-            true = np.asarray(true_object_pose, dtype=np.float32)[:, 7 * k : 7 * k + 3]
-            half = np.full((n, 3), self.half, dtype=np.float32)
-            for name, centers, color in (("believed", believed, (219, 68, 55)), ("true", true, (15, 157, 88))):
+            believed = np.asarray(env_state, dtype=float)[:, 7 * k : 7 * k + 7]
+            true = np.asarray(true_object_pose, dtype=float)[:, 7 * k : 7 * k + 7]
+            for name, poses, color in (("believed", believed, (219, 68, 55)), ("true", true, (15, 157, 88))):
                 stream.send_columns(
                     f"{root}/{obj}/{name}",
                     indexes=[frames],
-                    columns=rr.Boxes3D.columns(centers=centers, half_sizes=half, colors=np.tile(color, (n, 1))),
+                    columns=self._boxes(obj, poses, color),
                 )
         for j, name in enumerate(self.spec.action_names):
             stream.send_columns(
@@ -144,7 +144,7 @@ class EpisodeLogger:
         stream.send_columns(
             f"{root}/gripper", indexes=[frames], columns=rr.Scalars.columns(scalars=np.asarray(state)[:, -1])
         )
-        self._events(root, phases, env_state, success, n)
+        self._events(root, phases, revealed, success, n)
         for source_index, path in (source_paths or {}).items():
             stream.log(
                 f"sources/{source_index}/recovery",
@@ -153,10 +153,27 @@ class EpisodeLogger:
             )
         self.episodes += 1
 
-    def _events(self, root: str, phases: np.ndarray, env_state: np.ndarray, success: bool, n: int) -> None:
+    def _boxes(self, obj: str, poses: np.ndarray, color: tuple[int, int, int]):
+        """Box columns of ``obj`` at ``poses`` (N, 7: position + quaternion xyzw), drawn with their rotation."""
+        from scipy.spatial.transform import Rotation
+
+        box = self.spec.box(obj)
+        n = len(poses)
+        quats = poses[:, 3:7]
+        valid = np.linalg.norm(quats, axis=1) > 0.5
+        quats = np.where(valid[:, None], quats, [0.0, 0.0, 0.0, 1.0])
+        centers = poses[:, :3] + Rotation.from_quat(quats).apply(np.asarray(box.center, dtype=float))
+        return self.rr.Boxes3D.columns(
+            centers=centers.astype(np.float32),
+            half_sizes=np.tile(np.asarray(box.half_size, dtype=np.float32), (n, 1)),
+            quaternions=quats.astype(np.float32),
+            colors=np.tile(color, (n, 1)),
+        )
+
+    def _events(self, root: str, phases: np.ndarray, revealed: np.ndarray, success: bool, n: int) -> None:
         rr, stream = self.rr, self.stream
         events: list[tuple[int, str]] = []
-        revealed = np.flatnonzero(np.asarray(env_state)[:, -1] > 0.5)
+        revealed = np.flatnonzero(revealed)
         if len(revealed):
             events.append((int(revealed[0]), "first contact: the true pose is revealed"))
         recovery = np.flatnonzero(np.isin(phases, [Phase.OPERATOR, Phase.GENERATED, Phase.INTERPOLATION]))

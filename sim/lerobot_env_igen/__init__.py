@@ -1,27 +1,40 @@
 """igen simulated tasks as a LeRobot env plugin.
 
 LeRobot imports every installed distribution whose name starts with ``lerobot_env_`` (see
-``lerobot.utils.import_utils.register_third_party_plugins``); importing this package registers
-our env configs (``--env.type=block_grasp``) and their gymnasium ids. It imports neither MuJoCo
-nor robosuite: those load when an env is built.
+``lerobot.utils.import_utils.register_third_party_plugins``); importing this package imports the
+``config`` module of every task folder in it, which registers the task's env config
+(``--env.type=<task>``), and registers each task's gymnasium id. A task is a folder: adding one
+needs no edit here. It imports neither MuJoCo nor robosuite: those load when an env is built.
 """
 
+import importlib
+import importlib.util
 import os
-
-import gymnasium as gym
+import pkgutil
 
 # Headless machines (and lerobot-eval's video rendering on them) need MuJoCo's EGL backend; it
 # must be chosen before MuJoCo is first imported. An explicit MUJOCO_GL always wins.
 if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
     os.environ["MUJOCO_GL"] = "egl"
 
-from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
+from igen_lerobot.core.env_config import TaskEnvConfig, register_gym_env  # noqa: E402
 
-__all__ = ["BlockGraspEnvConfig"]
 
-_GYM_ENTRY_POINT = "igen_lerobot.core.gym_env:TaskGymEnv"
+def _task_configs() -> dict[str, type[TaskEnvConfig]]:
+    """The config class of every task folder (a subpackage with a ``config`` module)."""
+    found = {}
+    for module in pkgutil.iter_modules(__path__):
+        if not module.ispkg or not importlib.util.find_spec(f"{__name__}.{module.name}.config"):
+            continue
+        config = importlib.import_module(f"{__name__}.{module.name}.config")
+        for value in vars(config).values():
+            if isinstance(value, type) and issubclass(value, TaskEnvConfig) and value.__module__ == config.__name__:
+                found[module.name] = value
+    return found
 
-for _config_cls in (BlockGraspEnvConfig,):
-    _gym_id = f"lerobot_env_igen/{_config_cls.task}"
-    if _gym_id not in gym.registry:
-        gym.register(id=_gym_id, entry_point=_GYM_ENTRY_POINT, disable_env_checker=True)
+
+TASK_CONFIGS = _task_configs()
+for _config_cls in TASK_CONFIGS.values():
+    register_gym_env(_config_cls)
+
+__all__ = ["TASK_CONFIGS"]

@@ -1,11 +1,15 @@
 """A Panda arm with its gripper inside a compiled scene: reset, control period, contacts.
 
-Control: every control period holds one Cartesian goal and runs ``substeps`` physics steps of
-2 ms, computing OSC torques at each (``mj_step1`` -> torques -> ``mj_step2``, as robosuite does).
-The gripper is a binary command rate-limited like robosuite's Panda gripper controller.
+Control: every control period holds one Cartesian goal (position and orientation) and runs
+``substeps`` physics steps of 2 ms, computing OSC torques at each (``mj_step1`` -> torques ->
+``mj_step2``, as robosuite does). The gripper is a binary command rate-limited like robosuite's
+Panda gripper controller. A period can watch one pair of geom sets (say, nut and peg) and
+report where they first touched.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import mujoco
 import numba
@@ -40,6 +44,14 @@ def _pair_mask(pairs, mask_a, mask_b):  # pragma: no cover - compiled
     return out
 
 
+@dataclass(frozen=True)
+class ContactEvent:
+    """Where a watched pair of geom sets first touched during a control period."""
+
+    position: np.ndarray  # [m] mean of the pair's contact points at that substep
+    geom_pairs: np.ndarray  # (k, 2) the touching geom ids
+
+
 def _ids(model: mujoco.MjModel, kind: mujoco.mjtObj, names: tuple[str, ...]) -> np.ndarray:
     return np.array([mujoco.mj_name2id(model, kind, n) for n in names])
 
@@ -55,6 +67,7 @@ class PandaArm:
         control_hz: int,
         names: SceneNames = SCENE_NAMES,
         gains: OscGains = DEFAULT_GAINS,
+        home_rot: np.ndarray = TOP_DOWN_ROT,
     ) -> None:
         self.model = model
         self.data = mujoco.MjData(model)
@@ -73,10 +86,11 @@ class PandaArm:
             raise ValueError(f"control_hz={control_hz} is faster than the physics step {model.opt.timestep} s")
         self.gripper_geoms = self._gripper_geom_ids()
         self.gripper_geom_mask = self.geom_mask(self.gripper_geoms)
+        self.home_rot = np.asarray(home_rot, dtype=float)
         self.home_qpos = self._solve_home(default_qpos, np.asarray(home_pos, float))
         self.osc = OperationalSpaceController(model, self.site, self.arm_dofs, self.home_qpos, self.arm_qpos, gains)
         self.goal_pos = np.zeros(3)
-        self.goal_rot = TOP_DOWN_ROT.copy()
+        self.goal_rot = self.home_rot.copy()
         self._gripper_level = -1.0  # -1 open ... +1 closed
         self.peak_contact_force = 0.0  # [N] see control_period(measure_force=True)
 
@@ -100,7 +114,7 @@ class PandaArm:
         return np.array(sorted(geoms))
 
     def _solve_home(self, start_qpos: np.ndarray, target_pos: np.ndarray) -> np.ndarray:
-        """Joint configuration with the end effector top-down at ``target_pos`` (damped least squares)."""
+        """Joint configuration with the end effector at ``target_pos`` in ``home_rot`` (damped least squares)."""
         data = mujoco.MjData(self.model)
         data.qpos[self.arm_qpos] = start_qpos
         jacp, jacr = np.zeros((3, self.model.nv)), np.zeros((3, self.model.nv))
@@ -108,7 +122,7 @@ class PandaArm:
             mujoco.mj_kinematics(self.model, data)
             pos = data.site_xpos[self.site]
             rot = data.site_xmat[self.site].reshape(3, 3)
-            err = np.concatenate([target_pos - pos, orientation_error(TOP_DOWN_ROT, rot)])
+            err = np.concatenate([target_pos - pos, orientation_error(self.home_rot, rot)])
             if np.linalg.norm(err) < 1e-6:
                 break
             mujoco.mj_comPos(self.model, data)
@@ -128,7 +142,7 @@ class PandaArm:
         self._apply_gripper_ctrl()
         mujoco.mj_forward(self.model, self.data)
         self.goal_pos = self.data.site_xpos[self.site].copy()
-        self.goal_rot = TOP_DOWN_ROT.copy()
+        self.goal_rot = self.home_rot.copy()
 
     def eef_pose(self) -> np.ndarray:
         pose = np.eye(4)
@@ -149,6 +163,12 @@ class PandaArm:
         return float(q[0] - q[1])
 
     # ------------------------------------------------------------------ control
+    def hold_closed(self, finger_opening: float) -> None:
+        """Put the fingers at ``finger_opening`` [m] each, commanded closed (an object starts in the hand)."""
+        self.data.qpos[self.finger_qpos] = (finger_opening, -finger_opening)
+        self._gripper_level = 1.0
+        self._apply_gripper_ctrl()
+
     def _apply_gripper_ctrl(self) -> None:
         opening = FINGER_OPEN * 0.5 * (1.0 - self._gripper_level)  # level -1 -> open, +1 -> closed
         self.data.ctrl[self.finger_act] = (opening, -opening)
@@ -163,32 +183,48 @@ class PandaArm:
         self,
         goal_pos: np.ndarray,
         close_gripper: bool,
-        touch_mask: np.ndarray | None = None,
+        goal_rot: np.ndarray | None = None,
+        watch: tuple[np.ndarray, np.ndarray] | None = None,
         measure_force: bool = False,
-    ) -> bool:
-        """Hold ``goal_pos`` (and the top-down orientation) for one control period.
+    ) -> ContactEvent | None:
+        """Hold ``goal_pos`` and ``goal_rot`` (default: the last goal orientation) for one control period.
 
-        Returns whether the gripper touched any geom in ``touch_mask`` (see :meth:`geom_mask`)
-        at any substep of the period. With ``measure_force``, :attr:`peak_contact_force` is the
-        largest :meth:`contact_force` seen during the period (what a real arm's external-force
-        estimate would show).
+        ``watch`` is a pair of geom masks (see :meth:`geom_mask`); the return value says where
+        they first touched during the period, or None if they did not. With ``measure_force``,
+        :attr:`peak_contact_force` is the largest :meth:`contact_force` seen during the period
+        (what a real arm's external-force estimate would show).
         """
         self.goal_pos = np.asarray(goal_pos, dtype=float)
+        if goal_rot is not None:
+            self.goal_rot = np.ascontiguousarray(goal_rot, dtype=float)
         step = GRIPPER_RATE if close_gripper else -GRIPPER_RATE
         self._gripper_level = min(1.0, max(-1.0, self._gripper_level + step))
         self._apply_gripper_ctrl()
         model, data, act = self.model, self.data, self.arm_act
-        touched = False
+        event: ContactEvent | None = None
         self.peak_contact_force = 0.0
         for _ in range(self.substeps):
             mujoco.mj_step1(model, data)
             data.ctrl[act] = self.osc.torques(data, self.goal_pos, self.goal_rot)
             mujoco.mj_step2(model, data)
-            if touch_mask is not None and not touched:
-                touched = self.touching(touch_mask)
+            if watch is not None and event is None and data.ncon:
+                event = self._first_contact(*watch)
             if measure_force:
                 self.peak_contact_force = max(self.peak_contact_force, self.contact_force())
-        return touched
+        return event
+
+    def in_contact(self, mask_a: np.ndarray, mask_b: np.ndarray) -> bool:
+        """Whether any geom in ``mask_a`` touches any geom in ``mask_b`` now."""
+        ncon = self.data.ncon
+        return bool(ncon) and bool(_any_pair(self.data.contact.geom[:ncon], mask_a, mask_b))
+
+    def _first_contact(self, mask_a: np.ndarray, mask_b: np.ndarray) -> ContactEvent | None:
+        ncon = self.data.ncon
+        pairs = self.data.contact.geom[:ncon]
+        if not _any_pair(pairs, mask_a, mask_b):
+            return None
+        hits = _pair_mask(pairs, mask_a, mask_b)
+        return ContactEvent(position=self.data.contact.pos[:ncon][hits].mean(axis=0), geom_pairs=pairs[hits].copy())
 
     def contact_force(self) -> float:
         """Magnitude of the net contact force on the hand and fingers from everything else [N]."""
@@ -207,20 +243,3 @@ class PandaArm:
             force = contact.frame.reshape(3, 3).T @ wrench[:3]  # contact frame -> world, acting on geom2
             total += force if mask[g2] else -force
         return float(np.linalg.norm(total))
-
-    def _contact_mask(self, obj_mask: np.ndarray) -> np.ndarray:
-        pairs = self.data.contact.geom[: self.data.ncon]
-        return _pair_mask(pairs, self.gripper_geom_mask, obj_mask)
-
-    def touching(self, obj_mask: np.ndarray) -> bool:
-        """Whether the gripper is in contact with any geom in ``obj_mask`` now."""
-        ncon = self.data.ncon
-        if ncon == 0:
-            return False
-        return _any_pair(self.data.contact.geom[:ncon], self.gripper_geom_mask, obj_mask)
-
-    def contact_points(self, obj_mask: np.ndarray) -> np.ndarray:
-        """World positions (k, 3) of the gripper's current contacts with geoms in ``obj_mask``."""
-        if self.data.ncon == 0:
-            return np.zeros((0, 3))
-        return self.data.contact.pos[: self.data.ncon][self._contact_mask(obj_mask)].copy()

@@ -37,13 +37,12 @@ class SceneNames:
     gripper_body_root: str = "gripper0_right_right_gripper"
 
 
-def build_panda_table_scene(
-    boxes: dict[str, tuple[float, tuple[float, float, float, float]]],
-) -> tuple[mujoco.MjModel, np.ndarray]:
-    """Compile a Panda + table + free boxes scene.
+def build_panda_table_scene(objects: list) -> tuple[mujoco.MjModel, np.ndarray]:
+    """Compile a Panda + table scene holding robosuite objects.
 
     Args:
-        boxes: object name -> (half size [m], rgba) for each free-floating cube.
+        objects: robosuite ``MujocoObject`` instances, free (default joints) or fixed
+            (``joints=None``); each becomes a body ``<name>_main`` that the task moves at reset.
 
     Returns:
         The compiled model and robosuite's default Panda joint configuration (7,).
@@ -52,7 +51,6 @@ def build_panda_table_scene(
     from robosuite.models.arenas import TableArena
     from robosuite.models.bases import robot_base_factory
     from robosuite.models.grippers import gripper_factory
-    from robosuite.models.objects import BoxObject
     from robosuite.models.robots import Panda
     from robosuite.models.tasks import ManipulationTask
 
@@ -62,7 +60,14 @@ def build_panda_table_scene(
     robot.set_base_xpos(robot.base_xpos_offset["table"](TABLE_FULL_SIZE[0]))
     arena = TableArena(table_full_size=TABLE_FULL_SIZE, table_offset=(0.0, 0.0, TABLE_TOP_Z))
     arena.set_origin([0, 0, 0])
-    objects = [BoxObject(name=name, size=[half] * 3, rgba=list(rgba)) for name, (half, rgba) in boxes.items()]
-    task = ManipulationTask(mujoco_arena=arena, mujoco_robots=[robot], mujoco_objects=objects)
+    task = ManipulationTask(mujoco_arena=arena, mujoco_robots=[robot], mujoco_objects=list(objects))
     model = task.get_model(mode="mujoco")
     return model, np.asarray(robot.init_qpos, dtype=float)
+
+
+def box(name: str, half_size: float | tuple[float, float, float], rgba: tuple[float, ...], fixed: bool = False):
+    """A robosuite box object; ``fixed`` makes it part of the scenery (moved only at reset)."""
+    from robosuite.models.objects import BoxObject
+
+    half = [half_size] * 3 if np.isscalar(half_size) else list(half_size)
+    return BoxObject(name=name, size=half, rgba=list(rgba), joints=None if fixed else "default")

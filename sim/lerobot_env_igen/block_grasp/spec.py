@@ -17,6 +17,9 @@ SPEC = TaskSpec(
     state_names=("eef.x", "eef.y", "eef.z", "eef.qx", "eef.qy", "eef.qz", "eef.qw", "gripper.width"),
     env_state_names=("cube.x", "cube.y", "cube.z", "cube.qx", "cube.qy", "cube.qz", "cube.qw", "contact", "revealed"),
     action_names=("delta.x", "delta.y", "delta.z", "gripper"),
+    corrupted_object="cube",
+    corruption_names=("cube.dx", "cube.dy", "cube.dz"),
+    reveal_contact=("gripper", "cube"),
 )
 
 

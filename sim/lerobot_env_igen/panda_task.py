@@ -1,0 +1,240 @@
+"""What every simulated task shares: a Panda at a table, objects, the belief, the action space.
+
+A task supplies its scene objects, how a seed places them (:meth:`PandaTaskEnv.place`), its
+success test and, if it differs from the default, its mistake signal and subtask progress. The
+base does the rest the same way for every task: one compiled model whose free objects are set
+through their joints and fixed ones (peg, receptacle, holder) through ``model.body_pos`` at
+reset, 6-DOF or position-only actions at 20 Hz, contact detection between any two named parts,
+the core's :class:`~igen_lerobot.core.belief.ObjectBelief` for the corrupted object, and the
+observation layout of :mod:`igen_lerobot.core.task`.
+"""
+
+from __future__ import annotations
+
+import abc
+import logging
+
+import mujoco
+import numpy as np
+
+from igen_lerobot.core.actions import ActionSpace
+from igen_lerobot.core.belief import ObjectBelief, Reveal
+from igen_lerobot.core.error_models import ErrorModel
+from igen_lerobot.core.observation import observation
+from igen_lerobot.core.task import StepInfo, TaskEnv, TaskSpec
+from lerobot_env_igen.panda import TOP_DOWN_ROT, ContactEvent, PandaArm
+from lerobot_env_igen.scene import build_panda_table_scene
+
+logger = logging.getLogger(__name__)
+
+GRIPPER = "gripper"  # the hand and fingers, as a contact party
+
+
+class PandaTaskEnv(TaskEnv):
+    """A task on the compiled robosuite Panda scene."""
+
+    def __init__(
+        self,
+        spec: TaskSpec,
+        action_space: ActionSpace,
+        error_model: ErrorModel,
+        objects: list,
+        home_pos: tuple[float, float, float],
+        home_rot: np.ndarray = TOP_DOWN_ROT,
+    ) -> None:
+        if tuple(action_space.names) != tuple(spec.action_names):
+            raise ValueError(f"task {spec.name!r}: action space {action_space.names} != spec {spec.action_names}")
+        self.spec = spec
+        self.action_space = action_space
+        self.error_model = error_model
+        model, default_qpos = build_panda_table_scene(objects)
+        home = np.asarray(home_pos, dtype=float)
+        self.arm = PandaArm(model, default_qpos, home, control_hz=spec.fps, home_rot=home_rot)
+        self.model, self.data = model, self.arm.data
+        self.bodies = {name: self._body(f"{name}_main") for name in spec.objects}
+        self.part_masks = {name: self.arm.geom_mask(self.collision_geoms(body)) for name, body in self.bodies.items()}
+        self.part_masks[GRIPPER] = self.arm.gripper_geom_mask
+        self._free_qpos = {
+            name: model.jnt_qposadr[model.body_jntadr[body]]
+            for name, body in self.bodies.items()
+            if model.body_jntnum[body] > 0
+        }
+        self._reveal_watch = None
+        if spec.reveal_contact is not None:
+            self._reveal_watch = tuple(self.part_masks[p] for p in spec.reveal_contact)
+        self.belief = ObjectBelief(error_model, error_model.sample(np.random.default_rng(0)), spec.reveal)
+        self.last_reveal_contact: ContactEvent | None = None  # the contact that revealed, for tests and logs
+        self._steps = 0
+        self._renderer: mujoco.Renderer | None = None
+        self._render_option = mujoco.MjvOption()
+        self._render_option.sitegroup[:] = 0  # hide robosuite's helper sites (grip axis, frames)
+
+    # ------------------------------------------------------------------ model lookups
+    def _body(self, name: str) -> int:
+        body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+        if body < 0:
+            raise ValueError(f"task {self.spec.name!r}: the scene has no body {name!r}")
+        return body
+
+    def collision_geoms(self, body: int) -> list[int]:
+        """Geoms of ``body`` that collide (robosuite's ``_visual`` copies do not)."""
+        model = self.model
+        return [g for g in range(model.ngeom) if model.geom_bodyid[g] == body and model.geom_contype[g]]
+
+    def body_pose(self, body: int) -> np.ndarray:
+        pose = np.eye(4)
+        pose[:3, :3] = self.data.xmat[body].reshape(3, 3)
+        pose[:3, 3] = self.data.xpos[body]
+        return pose
+
+    def set_free_pose(self, name: str, pos: np.ndarray, quat_wxyz: np.ndarray = (1.0, 0.0, 0.0, 0.0)) -> None:
+        """Place a free object (position [m], MuJoCo quaternion), at rest."""
+        adr = self._free_qpos[name]
+        self.data.qpos[adr : adr + 3] = pos
+        self.data.qpos[adr + 3 : adr + 7] = quat_wxyz
+        dof = self.model.jnt_dofadr[self.model.body_jntadr[self.bodies[name]]]
+        self.data.qvel[dof : dof + 6] = 0.0
+
+    def set_fixed_pose(self, name: str, pos: np.ndarray, quat_wxyz: np.ndarray = (1.0, 0.0, 0.0, 0.0)) -> None:
+        """Move a fixed body (no recompiling: its pose lives in ``model.body_pos``/``body_quat``)."""
+        body = self.bodies[name]
+        self.model.body_pos[body] = pos
+        self.model.body_quat[body] = quat_wxyz
+
+    def parts_in_contact(self, a: str, b: str) -> bool:
+        """Whether two named parts (objects or ``gripper``) touch now."""
+        return self.arm.in_contact(self.part_masks[a], self.part_masks[b])
+
+    # ------------------------------------------------------------------ task hooks
+    @abc.abstractmethod
+    def place(self, rng: np.random.Generator) -> None:
+        """Lay out a new scene from ``rng`` (the arm is at home, fingers open, nothing moving yet)."""
+
+    @abc.abstractmethod
+    def is_success(self) -> bool:
+        """The task's success test on the current state."""
+
+    def settle(self) -> None:
+        """Run after placing and before the first observation (e.g. let a held object settle)."""
+
+    def mistake(self, revealed_now: bool, close_gripper: bool) -> bool:
+        """The task's mistake signal for this step: by default the contact that reveals."""
+        return revealed_now
+
+    def subtask_index(self) -> int:
+        return len(self.spec.subtasks) if self.is_success() else 0
+
+    # ------------------------------------------------------------------ episode
+    def reset(self, seed: int, corruption: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        rng = np.random.default_rng(seed)
+        self.arm.reset()
+        self.place(rng)
+        mujoco.mj_forward(self.model, self.data)
+        sampled = self.error_model.sample(rng)
+        sample = sampled if corruption is None else self.error_model.checked(corruption, "corruption override")
+        self.belief = ObjectBelief(self.error_model, sample, self.spec.reveal)
+        self.last_reveal_contact = None
+        self.settle()
+        self._steps = 0
+        return self.observe()
+
+    def step(self, action: np.ndarray) -> StepInfo:
+        action = self.action_space.checked(action, self.spec.name)
+        target = self.action_space.target_pose(self.eef_pose(), action)
+        return self.step_to(target[:3, 3], self.action_space.gripper_closed(action), goal_rot=target[:3, :3])
+
+    def step_to(
+        self,
+        goal_pos: np.ndarray,
+        close_gripper: bool,
+        measure_force: bool = False,
+        goal_rot: np.ndarray | None = None,
+    ) -> StepInfo:
+        """One control period towards an absolute end-effector goal (a driver's Cartesian target).
+
+        ``goal_rot`` None keeps the last goal orientation. With ``measure_force`` the arm records
+        the period's peak contact force on the gripper (``self.arm.peak_contact_force``), the
+        simulated counterpart of a real arm's estimate.
+        """
+        event = self.arm.control_period(
+            np.asarray(goal_pos, dtype=float), close_gripper, goal_rot, self._reveal_watch, measure_force
+        )
+        self._steps += 1
+        revealed_now = False
+        if self._reveal_watch is not None:
+            T_true = self.true_object_poses()[self.spec.corrupted_object]
+            revealed_now = self.belief.update(event is not None, None if event is None else event.position, T_true)
+            if revealed_now:
+                self.last_reveal_contact = event
+                logger.debug("%s revealed at step %d (%s)", self.spec.corrupted_object, self._steps, self.spec.reveal)
+        return StepInfo(
+            contact=event is not None,
+            revealed=self.belief.revealed,
+            success=self.is_success(),
+            mistake=self.mistake(revealed_now, close_gripper),
+        )
+
+    # ------------------------------------------------------------------ observation
+    def observe(self) -> dict[str, np.ndarray]:
+        return observation(self.spec, self.eef_pose(), self.gripper_width(), self.believed_object_poses(), self.belief)
+
+    def true_object_poses(self) -> dict[str, np.ndarray]:
+        return {name: self.body_pose(body) for name, body in self.bodies.items()}
+
+    def true_object_pose_vector(self) -> np.ndarray:
+        # recorded on every frame: MuJoCo's body quaternions, not a conversion from matrices
+        out = np.empty(7 * len(self.bodies))
+        for k, body in enumerate(self.bodies.values()):
+            quat = self.data.xquat[body]
+            out[7 * k : 7 * k + 3] = self.data.xpos[body]
+            out[7 * k + 3 : 7 * k + 7] = (quat[1], quat[2], quat[3], quat[0])
+        return out
+
+    def believed_object_poses(self) -> dict[str, np.ndarray]:
+        poses = self.true_object_poses()
+        obj = self.spec.corrupted_object
+        poses[obj] = self.belief.believed_pose(poses[obj])
+        return poses
+
+    def eef_pose(self) -> np.ndarray:
+        return self.arm.eef_pose()
+
+    def gripper_width(self) -> float:
+        return self.arm.gripper_width()
+
+    @property
+    def corruption(self) -> np.ndarray:
+        return self.belief.sample.copy()
+
+    @property
+    def contact(self) -> bool:
+        return self.belief.contact
+
+    @property
+    def revealed(self) -> bool:
+        return self.belief.revealed
+
+    @property
+    def reveal_mode(self) -> Reveal:
+        return self.spec.reveal
+
+    # ------------------------------------------------------------------ rendering
+    def render(self, camera: str = "frontview", width: int = 256, height: int = 256) -> np.ndarray:
+        """RGB image (H, W, 3) uint8 from one of the scene's cameras (needs MUJOCO_GL=egl headless)."""
+        if self._renderer is None or (self._renderer.width, self._renderer.height) != (width, height):
+            if self._renderer is not None:
+                self._renderer.close()
+            try:
+                self._renderer = mujoco.Renderer(self.model, height=height, width=width)
+            except mujoco.FatalError as err:
+                raise RuntimeError(
+                    "MuJoCo could not create an OpenGL context for rendering. On a headless machine set "
+                    "MUJOCO_GL=egl before starting Python (and install libegl1/libgl1-mesa-dri: scripts/setup.sh)."
+                ) from err
+        self._renderer.update_scene(self.data, camera=camera, scene_option=self._render_option)
+        return self._renderer.render()
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
