@@ -8,6 +8,8 @@ import subprocess  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+# the numpy-only fake task registers itself as an igen task, so the per-task tests cover it too
+import fake_task  # noqa: E402, F401
 import pytest  # noqa: E402
 
 

@@ -92,10 +92,9 @@ def test_lerobot_train_checkpoint_loads_and_acts_in_our_env(bc_rnn_checkpoint, b
 
 
 def test_checkpoint_of_another_feature_set_is_rejected(bc_rnn_checkpoint, block_grasp_env):
+    from igen_lerobot.core.belief import Reveal
     from igen_lerobot.core.exceptions import TaskMismatchError
     from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
-
-    from igen_lerobot.core.belief import Reveal
 
     # the same task under another reveal mode observes three more values (the direction hint)
     other = block_grasp_env.spec.with_reveal(Reveal.DIRECTION)

@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 
 from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.env_config import known_tasks
 from igen_lerobot.core.error_models import NoNoise
-from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE
+from igen_lerobot.core.task import OBS_ENV_STATE
 
 
 def run_scripted_operator(env, seed, max_steps=200):
@@ -86,21 +85,6 @@ def test_partial_reveal_gives_the_contact_position_only(block_grasp_config):
     true_cube = env.true_object_poses()["cube"][:3, 3]
     assert np.linalg.norm(believed - true_cube) > 1e-3  # not the true centre...
     assert np.all(np.abs(believed - true_cube) <= 0.025 + 0.006)  # ...but a point on the cube's surface
-
-
-@pytest.mark.parametrize("task_name", sorted(known_tasks()))
-def test_every_registered_task_observes_its_declared_features(task_name):
-    cfg = known_tasks()[task_name]()
-    spec = cfg.task_spec
-    env = cfg.make_task_env()
-    obs = env.reset(0)
-    assert obs[OBS_STATE].shape == (len(spec.state_names),) == cfg.features["agent_pos"].shape
-    assert obs[OBS_ENV_STATE].shape == (len(spec.env_state_names),) == cfg.features["environment_state"].shape
-    assert env.true_object_pose_vector().shape == (len(spec.object_pose_names),)
-    assert env.corruption.shape == (len(spec.corruption_names),)
-    info = env.step(np.zeros(len(spec.action_names)))
-    assert not info.success
-    env.close()
 
 
 def test_same_seed_same_scene(block_grasp_env):

@@ -250,6 +250,14 @@ class TaskEnv(abc.ABC):
     def revealed(self) -> bool:
         """Whether the reveal contact has happened in this episode."""
 
+    def revealing_parts(self) -> tuple[str, str] | None:
+        """The two parts whose contact revealed the corrupted object in this episode (None before it).
+
+        Names as in ``spec.reveal_contact`` (objects, or ``gripper``); tests and logs use it to check
+        that the reveal came from the declared contact.
+        """
+        return None
+
     def action_towards(self, T_world_eef_target: np.ndarray, gripper_closed: bool) -> np.ndarray:
         """The action that drives the end effector towards a target pose in one step."""
         return self.action_space.action_towards(self.eef_pose(), T_world_eef_target, gripper_closed)

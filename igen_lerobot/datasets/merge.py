@@ -69,6 +69,12 @@ def merge_datasets(
         info = read_igen_meta(root, "--inputs")
         if info.task != spec.name:
             raise TaskMismatchError(f"cannot merge {root}: it holds task {info.task!r}, not {spec.name!r}")
+        recorded = info.meta.get("reveal")
+        if recorded is not None and recorded != spec.reveal.value:
+            raise TaskMismatchError(
+                f"cannot merge {root}: it was recorded with --env.reveal={recorded}, the others with "
+                f"{spec.reveal.value}; a policy would see two meanings of one observation"
+            )
         lerobot_meta = LeRobotDatasetMetadata(f"local/{root.name}", root=root)
         check_features(lerobot_meta.features, spec, root, "--inputs")
         if lerobot_meta.total_episodes == 0:
@@ -95,6 +101,7 @@ def merge_datasets(
     merged = {
         "schema_version": SCHEMA_VERSION,
         "task": spec.name,
+        "reveal": spec.reveal.value,
         "episode_kinds": kinds,
         "created_by": "merge",
         "parts": [

@@ -58,7 +58,11 @@ def read_igen_meta(root: Path, flag: str = "--dataset.root") -> DatasetInfo:
 
 
 def dataset_spec(root: Path, flag: str = "--dataset.root") -> TaskSpec:
-    """The task spec a dataset was written under (its task, and the reveal mode its observation layout shows)."""
+    """The task spec a dataset was written under: its task, under the reveal mode it records.
+
+    Datasets written before the reveal mode was recorded get the task's default mode, provided
+    their observation layout fits it.
+    """
     from igen_lerobot.core.belief import Reveal
     from igen_lerobot.core.env_config import task_config_class
 
@@ -67,12 +71,16 @@ def dataset_spec(root: Path, flag: str = "--dataset.root") -> TaskSpec:
     base = task_config_class(info.task).base_spec
     features = json.loads((root / "meta" / "info.json").read_text())["features"]
     names = tuple(features.get(OBS_ENV_STATE, {}).get("names") or ())
-    candidates = [base.with_reveal(r) for r in Reveal if base.reveal_contact is not None or r is Reveal.NONE]
-    for spec in candidates:
+    recorded = info.meta.get("reveal")
+    modes = [Reveal(recorded)] if recorded else [base.reveal, *(r for r in Reveal if r is not base.reveal)]
+    for reveal in modes:
+        if base.reveal_contact is None and reveal is not Reveal.NONE:
+            continue
+        spec = base.with_reveal(reveal)
         if spec.env_state_names == names:
             return spec
     raise DatasetSchemaError(
-        f"{root} ({flag}): its {OBS_ENV_STATE} names {names} fit no layout of task {info.task!r} "
+        f"{flag}={root}: its {OBS_ENV_STATE} names {names} fit no layout of task {info.task!r} "
         f"(e.g. {base.env_state_names}); was it written by another version of the task?"
     )
 

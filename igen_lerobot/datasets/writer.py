@@ -127,7 +127,13 @@ class DatasetBuilder:
                 frames += episode.length
                 kinds[episode.kind] = kinds.get(episode.kind, 0) + 1
         dataset.finalize()
-        meta = {"schema_version": SCHEMA_VERSION, "task": self.spec.name, "episode_kinds": kinds, **metadata}
+        meta = {
+            "schema_version": SCHEMA_VERSION,
+            "task": self.spec.name,
+            "reveal": self.spec.reveal.value,
+            "episode_kinds": kinds,
+            **metadata,
+        }
         (build_dir / IGEN_META_FILE).write_text(json.dumps(meta, indent=2, default=str))
         self._publish(build_dir)
         seconds = time.perf_counter() - start

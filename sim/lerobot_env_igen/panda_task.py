@@ -101,6 +101,16 @@ class PandaTaskEnv(TaskEnv):
         self.model.body_pos[body] = pos
         self.model.body_quat[body] = quat_wxyz
 
+    def part_of_geom(self, geom: int) -> str | None:
+        """Which named part (an object or ``gripper``) a geom belongs to."""
+        return next((name for name, mask in self.part_masks.items() if mask[geom]), None)
+
+    def revealing_parts(self) -> tuple[str, str] | None:
+        if self.last_reveal_contact is None:
+            return None
+        g1, g2 = self.last_reveal_contact.geom_pairs[0]
+        return self.part_of_geom(int(g1)), self.part_of_geom(int(g2))
+
     def parts_in_contact(self, a: str, b: str) -> bool:
         """Whether two named parts (objects or ``gripper``) touch now."""
         return self.arm.in_contact(self.part_masks[a], self.part_masks[b])

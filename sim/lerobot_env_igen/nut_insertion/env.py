@@ -1,0 +1,107 @@
+"""Nut Insertion: a held square nut onto a square peg whose observed position is wrong until touched.
+
+Paper setup (IntervenGen, Experiment Setup): the nut starts in the hand, the peg is sampled in a
+10 x 10 cm region, its observed position is off by up to 4 cm per axis with at least 2 cm in one,
+and the nut-peg contact reveals the true peg pose (``--env.reveal=contact_position``: only the
+mean position of that first contact). 6-DOF delta-pose actions at 20 Hz.
+
+* The fingers hold the nut by its handle, closing across it; the nut's yaw is aligned with the
+  peg (a quarter turn apart fits as well: the hole is square), so insertion is a matter of
+  position, and the hand's orientation is held top-down by the scripted operator.
+* Success: robosuite's ``on_peg`` (nut centre within 3 cm of the peg axis in x and y, below the
+  table top + 5 cm) **and released** (no finger touches the nut): robosuite's test alone passes
+  while the nut still hangs in the hand.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from igen_lerobot.core.actions import DeltaPoseActions
+from igen_lerobot.core.belief import Reveal
+from igen_lerobot.core.error_models import ErrorModel
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.geometry import rot_z
+from lerobot_env_igen.nut_insertion.spec import (
+    NUT_HANDLE_GRIP_X,
+    ON_PEG_XY,
+    ON_PEG_Z,
+    PEG_CENTER_Z,
+    PEG_HALF,
+    SPEC,
+    TABLE_TOP_Z,
+    paper_corruption,
+)
+from lerobot_env_igen.panda import TOP_DOWN_ROT
+from lerobot_env_igen.panda_task import GRIPPER, PandaTaskEnv
+from lerobot_env_igen.scene import box
+
+HOME_EEF_POS = (-0.062, 0.0, 1.0)  # [m] with the nut held, its centre is over the region's centre, 6 cm above the peg
+NUT_YAW = np.pi  # the handle points back towards the robot
+PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site
+HANDLE_HALF_WIDTH = 0.015875  # [m]
+SETTLE_STEPS = 5  # control periods the closed fingers get to settle on the handle at reset
+PEG_RGBA = (0.55, 0.55, 0.6, 1.0)
+
+
+def square_nut():
+    """Robosuite's square nut (its model and meshes ship with robosuite, MIT)."""
+    from robosuite.models.objects import SquareNutObject
+
+    return SquareNutObject(name="nut")
+
+
+class NutInsertionEnv(PandaTaskEnv):
+    """The Nut Insertion task on the compiled robosuite Panda scene."""
+
+    def __init__(
+        self,
+        corruption: ErrorModel | None = None,
+        reveal: Reveal = Reveal.FULL,
+        peg_region: tuple[float, float] = (0.10, 0.10),
+        peg_center: tuple[float, float] = (0.0, 0.0),
+        max_delta: float = 0.03,
+        max_rotation: float = 0.2,
+    ) -> None:
+        if min(peg_region) < 0:
+            raise ConfigError(f"env.peg_region must be non-negative (x, y) extents [m], got {peg_region}")
+        super().__init__(
+            spec=SPEC.with_reveal(reveal),
+            action_space=DeltaPoseActions(max_delta=max_delta, max_rotation=max_rotation),
+            error_model=corruption if corruption is not None else paper_corruption(),
+            objects=[square_nut(), box("peg", PEG_HALF, PEG_RGBA, fixed=True)],
+            home_pos=HOME_EEF_POS,
+        )
+        self.peg_region = np.asarray(peg_region, dtype=float)
+        self.peg_center = np.asarray(peg_center, dtype=float)
+
+    def place(self, rng: np.random.Generator) -> None:
+        xy = self.peg_center + rng.uniform(-0.5, 0.5, size=2) * self.peg_region
+        self.set_fixed_pose("peg", (xy[0], xy[1], PEG_CENTER_Z))
+        # the nut in the hand: fingers across the handle, the pads' centres at the handle's mid-height
+        grip = self.arm.eef_pos()
+        rot = rot_z(NUT_YAW)
+        centre = grip - rot @ np.array([NUT_HANDLE_GRIP_X, 0.0, 0.0]) + np.array([0.0, 0.0, PAD_ABOVE_GRIP])
+        half = NUT_YAW / 2
+        self.set_free_pose("nut", centre, (np.cos(half), 0.0, 0.0, np.sin(half)))
+        self.arm.hold_closed(HANDLE_HALF_WIDTH + 0.0006)
+
+    def settle(self) -> None:
+        home = self.arm.eef_pos()
+        for _ in range(SETTLE_STEPS):
+            self.arm.control_period(home, True, TOP_DOWN_ROT)
+
+    # ------------------------------------------------------------------ judges
+    def nut_on_peg(self) -> bool:
+        """Robosuite's ``on_peg``: the nut centre near the peg axis and down at the table."""
+        nut = self.data.xpos[self.bodies["nut"]]
+        peg = self.data.xpos[self.bodies["peg"]]
+        near = abs(nut[0] - peg[0]) < ON_PEG_XY and abs(nut[1] - peg[1]) < ON_PEG_XY
+        return bool(near and nut[2] < TABLE_TOP_Z + ON_PEG_Z)
+
+    def released(self) -> bool:
+        """No part of the hand touches the nut."""
+        return not self.parts_in_contact(GRIPPER, "nut")
+
+    def is_success(self) -> bool:
+        return self.nut_on_peg() and self.released()
