@@ -139,15 +139,19 @@ class FakePickPlaceEnv(TaskEnv):
         poses["block"] = self.belief.believed_pose(poses["block"])
         return poses
 
-    def placed(self) -> bool:
+    def on_pad(self) -> bool:
+        """The block lies on the pad, let go of."""
         gap = np.linalg.norm(self.T_block[:2, 3] - self.T_pad[:2, 3])
         yaw = yaw_gap(yaw_of(self.T_block[:3, :3]), yaw_of(self.T_pad[:3, :3]), np.pi / 2)
-        return bool(self.held is None and gap < PLACE_TOL_XY and yaw < PLACE_TOL_YAW and self.T_eef[2, 3] > 0.06)
+        return bool(self.held is None and gap < PLACE_TOL_XY and yaw < PLACE_TOL_YAW)
+
+    def placed(self) -> bool:
+        return self.on_pad() and self.T_eef[2, 3] > 0.06  # and the hand is clear of it
 
     def subtask_index(self) -> int:
         if self.is_success():
             return 2
-        return 1 if self.held is not None else 0
+        return 1 if self.held is not None or self.on_pad() else 0
 
     def is_success(self) -> bool:
         return self.placed()

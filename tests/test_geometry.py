@@ -82,3 +82,20 @@ def test_interpolation_needs_a_step():
 
     with pytest.raises(ValueError, match="num_steps"):
         interpolate_poses(np.eye(4), np.eye(4), 0)
+
+
+@given(seeds)
+def test_quaternions_follow_mujocos_sign_convention(seed):
+    """Observations use MuJoCo's choice between q and -q (mju_mat2Quat), computed without MuJoCo."""
+    import mujoco
+
+    from igen_lerobot.core.geometry import quat_xyzw_from_matrix
+
+    rng = np.random.default_rng(seed)
+    rot = Rotation.random(random_state=rng).as_matrix()
+    if seed % 4 == 0:  # half turns, where the sign is a pure convention (the top-down gripper)
+        rot = Rotation.from_rotvec(np.pi * Rotation.random(random_state=rng).apply([1, 0, 0])).as_matrix()
+    ours = quat_xyzw_from_matrix(rot)
+    theirs = np.empty(4)
+    mujoco.mju_mat2Quat(theirs, rot.reshape(9))
+    np.testing.assert_allclose(ours, theirs[[1, 2, 3, 0]], atol=1e-12)  # MuJoCo is scalar-first
