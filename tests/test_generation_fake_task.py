@@ -89,9 +89,7 @@ def test_intervengen_replays_a_recovery_into_the_blocks_true_frame_after_the_pol
         relative = _hand_in_block_frame(env.spec, ep, _grasp_frame(ep))
         candidates = [pose_inv(s.T_world_obj) @ s.targets[-1] for s in recovery]
         assert min(np.abs(relative - c).max() for c in candidates) < 1e-5
-    ablation = [
-        generate_intervention(env, None, library, cfg, 900 + i, 320, MistakeSource.REPLAY) for i in range(8)
-    ]
+    ablation = [generate_intervention(env, None, library, cfg, 900 + i, 320, MistakeSource.REPLAY) for i in range(8)]
     kept = [a.episode for a in ablation if a.kept]
     assert kept and all(ep.kind == "igen_no_policy" and not (ep.source == FrameSource.POLICY).any() for ep in kept)
 

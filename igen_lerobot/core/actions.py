@@ -68,9 +68,7 @@ class DeltaPositionActions(ActionSpace):
     """
 
     max_delta: float = 0.03
-    fixed_rotation: tuple[tuple[float, ...], ...] = field(
-        default=((0.0, 1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0))
-    )
+    fixed_rotation: tuple[tuple[float, ...], ...] = field(default=((0.0, 1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0)))
 
     def __post_init__(self) -> None:
         if self.max_delta <= 0:

@@ -18,7 +18,6 @@ class TrainingFailedError(IgenError, RuntimeError):
     """lerobot-train exited with an error; the message carries the end of its log."""
 
 
-
 def checkpoint_path(output_dir: Path) -> Path:
     """The ``pretrained_model/`` folder of the last checkpoint of a lerobot-train run."""
     return Path(output_dir) / "checkpoints" / "last" / "pretrained_model"
