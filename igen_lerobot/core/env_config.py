@@ -50,7 +50,8 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
     paper_tables: ClassVar[tuple[PaperTable, ...]] = ()
 
     corruption: ErrorModel = field(default_factory=NoNoise)
-    reveal: Reveal = Reveal.FULL
+    # none | full | contact_position | direction (see igen_lerobot.core.belief); a Reveal once checked
+    reveal: str = Reveal.FULL
     episode_length: int = 200
     render_camera: str = "frontview"
     render_size: int = 256

@@ -8,8 +8,9 @@ from pathlib import Path
 
 import draccus
 
-from igen_lerobot.core.episode import Episode
+from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.error_models import NoNoise
+from igen_lerobot.core.exceptions import DatasetSchemaError
 from igen_lerobot.datasets.merge import merge_datasets
 from igen_lerobot.datasets.reader import load_episodes
 from igen_lerobot.datasets.writer import DatasetBuilder
@@ -17,7 +18,8 @@ from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.config_generate import GenerateConfig
 from igen_lerobot.generation.job import GenerationJob, GenerationMode
 from igen_lerobot.generation.runner import run_generation
-from igen_lerobot.generation.sources import parse_demos, parse_interventions
+from igen_lerobot.generation.sources import SegmentRole, SourceLibrary, parse_demos, parse_interventions
+from igen_lerobot.training.policy_source import check_policy_source
 from igen_lerobot.viz.rerun_log import EpisodeLogger
 
 logger = logging.getLogger(__name__)
@@ -46,6 +48,37 @@ def live_logger(viz: EpisodeLogger, spool, sources: list[Episode]):
     return on_result
 
 
+def check_source_kinds(episodes: list[Episode], mode: GenerationMode, root: Path) -> None:
+    """MimicGen replays demonstrations; IntervenGen replays recorded recoveries."""
+    kinds = sorted({ep.kind for ep in episodes})
+    if mode is GenerationMode.MIMICGEN and not set(kinds) <= {EpisodeKind.DEMO, EpisodeKind.MIMICGEN}:
+        raise DatasetSchemaError(
+            f"--source.root={root} holds {kinds} episodes; MimicGen replays demonstrations: pass a dataset "
+            "recorded with igen-collect --mode=demos (or generated with --mode=mimicgen)"
+        )
+
+
+def check_sources_cover(library: SourceLibrary, mode: GenerationMode, root: Path) -> None:
+    """The sources hold every kind of segment the mode replays (checked before anything is written)."""
+    spec = library.spec
+    if mode is GenerationMode.MIMICGEN:
+        needed = [(SegmentRole.SUBTASK, k) for k in range(len(spec.subtasks))]
+    elif mode is GenerationMode.IGEN:
+        needed = [] if library.segments_of(SegmentRole.RECOVERY) else [(SegmentRole.RECOVERY, None)]
+    else:  # the ablation replays a source mistake of the first subtask, then recoveries
+        needed = [(SegmentRole.MISTAKE, 0)] + (
+            [] if library.segments_of(SegmentRole.RECOVERY) else [(SegmentRole.RECOVERY, None)]
+        )
+    for role, subtask in needed:
+        if subtask is None or not library.select(role, subtask):
+            which = "any subtask" if subtask is None else f"subtask {subtask} ({spec.subtasks[subtask].name!r})"
+            raise DatasetSchemaError(
+                f"--source.root={root} has no {role.value} segment for {which}, which --mode={mode.value} "
+                "replays; record sources that cover it (igen-collect "
+                f"--mode={'demos' if mode is GenerationMode.MIMICGEN else 'interventions'})"
+            )
+
+
 def generate(cfg: GenerateConfig) -> None:
     """Parse the sources, run the attempts (resumably), write the dataset, optionally merge."""
     env_cfg = cfg.env
@@ -62,8 +95,12 @@ def generate(cfg: GenerateConfig) -> None:
     episodes = load_episodes(source_root, spec, repo_id=cfg.source.repo_id, flag="--source.root")
     probe = env_cfg.make_task_env()  # only its action <-> target conversion is used here
     parse = parse_demos if mode is GenerationMode.MIMICGEN else parse_interventions
+    check_source_kinds(episodes, mode, source_root)
     library = parse(episodes, spec, probe.target_pose_from_action, probe.gripper_command)
     probe.close()
+    check_sources_cover(library, mode, source_root)
+    if mode is GenerationMode.IGEN:
+        check_policy_source(cfg.policy, env_cfg)  # a checkpoint of another task fails here, before any work
     logger.info("sources: %d episodes, %d segments from %s", len(episodes), len(library.segments), source_root)
 
     repo_id, root = cfg.dataset.resolve(f"{spec.name}_{mode.value}")

@@ -64,6 +64,9 @@ class SourceLibrary:
     def select(self, role: SegmentRole, subtask: int) -> list[SourceSegment]:
         return [s for s in self.segments if s.role == role and s.subtask == subtask]
 
+    def segments_of(self, role: SegmentRole) -> list[SourceSegment]:
+        return [s for s in self.segments if s.role == role]
+
     def require(self, role: SegmentRole, subtask: int) -> list[SourceSegment]:
         found = self.select(role, subtask)
         if not found:

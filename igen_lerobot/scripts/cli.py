@@ -26,31 +26,45 @@ def find_igen_error(error: BaseException) -> IgenError | None:
 
 
 def run_cli(config_class: type, command: Callable[..., object], prog: str) -> None:
-    """Parse the command line into ``config_class`` (LeRobot's parser) and run ``command`` on it.
+    """Parse the command line into ``config_class`` and run ``command`` on it.
 
-    LeRobot's parser reads the config type from the wrapped function's annotation at run time;
-    the small typed entry below gives it one, so library functions keep postponed annotations.
+    Parsing follows LeRobot's (plugin discovery flags, ``--config_path``, scoped ``--help``), with
+    one difference: when a config check of ours fails deep inside draccus (an env config inside a
+    union, say), the user sees our message with its fix, not draccus's "could not decode".
     """
-    from lerobot.configs import parser
     from lerobot.utils.import_utils import register_third_party_plugins
     from lerobot.utils.utils import init_logging
 
     init_logging()
     register_third_party_plugins()
     try:
-        parser.wrap()(_typed_entry(config_class, command))()
-    except Exception as error:  # noqa: BLE001 - re-raised unless it is one of ours
+        cfg = parse_config(config_class, sys.argv[1:])
+        command(cfg)
+    except Exception as error:  # noqa: BLE001 - re-raised unless it is one of ours or draccus's
         ours = find_igen_error(error)
-        if ours is None:
-            raise
-        print(f"{prog}: error: {ours}", file=sys.stderr)
-        raise SystemExit(2) from None
+        if ours is not None:
+            print(f"{prog}: error: {ours}", file=sys.stderr)
+            raise SystemExit(2) from None
+        import draccus
+
+        if isinstance(error, draccus.utils.ParsingError):
+            print(f"{prog}: error: {error}", file=sys.stderr)
+            raise SystemExit(2) from None
+        raise
 
 
-def _typed_entry(config_class: type, command: Callable[..., object]) -> Callable[..., object]:
-    def entry(cfg):  # noqa: ANN001 - annotated below, with the real class rather than a string
-        return command(cfg)
+def parse_config(config_class: type, cli_args: list[str]):
+    """``config_class`` from command-line arguments, as LeRobot's ``parser.wrap`` builds it."""
+    import draccus
+    from lerobot.configs import parser
 
-    entry.__annotations__ = {"cfg": config_class}
-    entry.__name__ = getattr(command, "__name__", "main")
-    return entry
+    for plugin_arg, plugin_path in parser.parse_plugin_args(parser.PLUGIN_DISCOVERY_SUFFIX, cli_args).items():
+        parser.load_plugin(plugin_path)
+        cli_args = parser.filter_arg(plugin_arg, cli_args)
+    if "--help" in cli_args or "-h" in cli_args:
+        parser.print_scoped_help(config_class, cli_args)
+        raise SystemExit(0)
+    config_path = parser.parse_arg("config_path", cli_args)
+    if config_path:
+        cli_args = parser.filter_arg("config_path", cli_args)
+    return draccus.parse(config_class=config_class, config_path=config_path, args=cli_args)

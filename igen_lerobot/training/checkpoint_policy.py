@@ -17,6 +17,9 @@ from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskSpec
 logger = logging.getLogger(__name__)
 
 
+FIX = "train a policy on a dataset of this task (and reveal mode), or run the task the checkpoint was trained on"
+
+
 def check_policy_features(input_features: dict, output_features: dict, spec: TaskSpec, where: str) -> None:
     """The checkpoint's inputs/outputs are exactly what the task provides, or a clear error."""
     provided = {OBS_STATE: (len(spec.state_names),), OBS_ENV_STATE: (len(spec.env_state_names),)}
@@ -28,12 +31,34 @@ def check_policy_features(input_features: dict, output_features: dict, spec: Tas
                 f"(it provides {', '.join(f'{k} {v}' for k, v in provided.items())})"
             )
         if shape != provided[key]:
-            raise TaskMismatchError(f"{where} expects {key} of shape {shape}; task {spec.name!r} gives {provided[key]}")
+            raise TaskMismatchError(
+                f"{where} expects {key} of shape {shape}; task {spec.name!r} gives {provided[key]}: {FIX}"
+            )
     action_shape = tuple(output_features[ACTION].shape) if ACTION in output_features else None
     if action_shape != (len(spec.action_names),):
+        wanted = (len(spec.action_names),)
         raise TaskMismatchError(
-            f"{where} outputs action of shape {action_shape}; task {spec.name!r} takes ({len(spec.action_names)},)"
+            f"{where} outputs action of shape {action_shape}; task {spec.name!r} takes {wanted}: {FIX}"
         )
+
+
+def read_checkpoint_config(path: str | Path, spec: TaskSpec):
+    """The checkpoint's LeRobot config, checked against ``spec`` (no weights are loaded)."""
+    from lerobot.configs.policies import PreTrainedConfig
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    # Plugin policy types (bc_rnn) must be registered in every process that loads one,
+    # generation workers included, not only in the one that parsed the command line.
+    register_third_party_plugins()
+    path = Path(path)
+    if not (path / "config.json").exists():
+        raise ConfigError(
+            f"--policy.path={path} has no config.json; point it at a checkpoint's pretrained_model/ folder, "
+            "e.g. outputs/train/<run>/checkpoints/last/pretrained_model"
+        )
+    config = PreTrainedConfig.from_pretrained(path)
+    check_policy_features(config.input_features, config.output_features, spec, f"--policy.path={path}")
+    return config
 
 
 class LeRobotCheckpointPolicy:
@@ -41,23 +66,11 @@ class LeRobotCheckpointPolicy:
 
     def __init__(self, path: str | Path, spec: TaskSpec, device: str = "cpu") -> None:
         import torch
-        from lerobot.configs.policies import PreTrainedConfig
         from lerobot.policies.factory import get_policy_class, make_pre_post_processors
-        from lerobot.utils.import_utils import register_third_party_plugins
-
-        # Plugin policy types (bc_rnn) must be registered in every process that loads one,
-        # generation workers included, not only in the one that parsed the command line.
-        register_third_party_plugins()
 
         path = Path(path)
-        if not (path / "config.json").exists():
-            raise ConfigError(
-                f"policy path {path} has no config.json; point it at a checkpoint's pretrained_model/ folder, "
-                "e.g. outputs/train/<run>/checkpoints/last/pretrained_model"
-            )
-        config = PreTrainedConfig.from_pretrained(path)
+        config = read_checkpoint_config(path, spec)
         config.device = device
-        check_policy_features(config.input_features, config.output_features, spec, f"policy {path}")
         self.policy = get_policy_class(config.type).from_pretrained(path, config=config)
         self.policy.eval()
         overrides = {"device_processor": {"device": device}}

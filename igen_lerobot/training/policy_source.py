@@ -29,3 +29,12 @@ def make_base_policy(cfg: PolicySourceConfig, env_config: TaskEnvConfig) -> Poli
 
         return LeRobotCheckpointPolicy(cfg.path, env_config.task_spec, device=cfg.device)
     return env_config.make_scripted_policy()
+
+
+def check_policy_source(cfg: PolicySourceConfig, env_config: TaskEnvConfig) -> None:
+    """A checkpoint's inputs and outputs fit the task, checked from its config alone (no weights loaded)."""
+    if not cfg.path:
+        return
+    from igen_lerobot.training.checkpoint_policy import read_checkpoint_config
+
+    read_checkpoint_config(cfg.path, env_config.task_spec)

@@ -18,6 +18,9 @@ if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
     os.environ["MUJOCO_GL"] = "egl"
 
 from igen_lerobot.core.env_config import TaskEnvConfig, register_gym_env  # noqa: E402
+from lerobot_env_igen.quiet import silence_robosuite_notices  # noqa: E402
+
+silence_robosuite_notices()
 
 
 def _task_configs() -> dict[str, type[TaskEnvConfig]]:
