@@ -1,10 +1,12 @@
-"""Block Grasp speed on one core: control steps/s vs the raw physics limit, reset time.
+"""Simulation speed of each task on one core: control steps/s vs the raw physics limit, reset time.
 
-Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_env.py [--steps 3000] [--repeats 3] [--robosuite]
+Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_env.py [--tasks block_grasp nut_insertion] \
+          [--steps 3000] [--repeats 3] [--robosuite]
 
 Pinned to CPU 0 with single-threaded BLAS, so the number is per core; each figure is the median
-of ``--repeats`` runs (this VM's speed drifts by +-20% between runs). ``--robosuite`` also times
-robosuite's stock Lift task with its Panda OSC controller for comparison.
+of ``--repeats`` runs, the tasks interleaved within a repeat (this VM's speed drifts by +-20%
+between runs). ``--robosuite`` also times robosuite's stock Lift task with its Panda OSC
+controller for comparison.
 """
 
 import argparse
@@ -21,16 +23,19 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def time_env(steps: int) -> dict:
-    from igen_lerobot.core.error_models import NoNoise
-    from lerobot_env_igen.block_grasp.env import BlockGraspEnv
-    from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator, ScriptedGraspPolicy
+def time_env(task: str, steps: int) -> dict:
+    import dataclasses
 
+    from igen_lerobot.collection.record import record_demo
+    from igen_lerobot.core.env_config import task_config_class
+    from igen_lerobot.core.error_models import NoNoise
+
+    cfg = task_config_class(task)()
     t0 = time.perf_counter()
-    env = BlockGraspEnv()
+    env = cfg.make_task_env()
     build_s = time.perf_counter() - t0
     env.reset(0)
-    env.step(np.zeros(4))  # compile the numba kernels outside the timed loops
+    env.step(np.zeros(len(env.spec.action_names)))  # compile the numba kernels outside the timed loops
 
     resets = []
     for seed in range(50):
@@ -39,12 +44,12 @@ def time_env(steps: int) -> dict:
         resets.append(time.perf_counter() - t0)
 
     # env.step + observe, driven by the scripted base policy (what generation runs)
-    policy = ScriptedGraspPolicy()
+    policy = cfg.make_scripted_policy()
     done, seed = 0, 0
     t0 = time.perf_counter()
     while done < steps:
         obs = env.reset(seed)
-        for _ in range(200):
+        for _ in range(cfg.episode_length):
             info = env.step(policy.act(obs))
             obs = env.observe()
             done += 1
@@ -63,15 +68,10 @@ def time_env(steps: int) -> dict:
     raw_s = time.perf_counter() - t0
     raw_ctrl_rate = n_raw / raw_s / env.arm.substeps
 
-    # scripted operator success on uncorrupted episodes (unchanged by the fast path)
-    clean = BlockGraspEnv(corruption=NoNoise())
-    operator, ok = ScriptedGraspOperator(), 0
-    for s in range(50):
-        clean.reset(10_000 + s)
-        for _ in range(200):
-            if clean.step(operator.act(clean)).success:
-                ok += 1
-                break
+    # scripted operator success on uncorrupted episodes
+    clean = dataclasses.replace(cfg, corruption=NoNoise()).make_task_env()
+    operator = cfg.make_scripted_operator()
+    ok = sum(record_demo(clean, operator, 10_000 + s, cfg.episode_length).success for s in range(50))
     return {
         "env_build_s": build_s,
         "reset_ms_median": 1000 * float(np.median(resets)),
@@ -110,20 +110,22 @@ def time_robosuite_lift(steps: int) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser()
+    parser.add_argument("--tasks", nargs="+", default=["block_grasp", "nut_insertion"])
     parser.add_argument("--steps", type=int, default=3000)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--robosuite", action="store_true")
     args = parser.parse_args()
     os.sched_setaffinity(0, {0})
-    runs = [time_env(args.steps) for _ in range(args.repeats)]
-    if args.robosuite:
-        lift = [time_robosuite_lift(min(args.steps, 600)) for _ in range(args.repeats)]
-        runs = [{**r, **lift_run} for r, lift_run in zip(runs, lift, strict=True)]
+    runs = [{task: time_env(task, args.steps) for task in args.tasks} for _ in range(args.repeats)]
     result = {
         "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
         "repeats": args.repeats,
     }
-    result.update({key: float(np.median([r[key] for r in runs])) for key in runs[0]})
+    for task in args.tasks:
+        result[task] = {key: float(np.median([r[task][key] for r in runs])) for key in runs[0][task]}
+    if args.robosuite:
+        lift = [time_robosuite_lift(min(args.steps, 600)) for _ in range(args.repeats)]
+        result["robosuite_lift"] = {k: float(np.median([r[k] for r in lift])) for k in lift[0]}
     print(json.dumps(result, indent=2))
 
 

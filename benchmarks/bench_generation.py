@@ -1,12 +1,15 @@
-r"""Generation throughput, engine overhead, worker scaling and memory (issue: generation engine).
+r"""Generation throughput, engine overhead, worker scaling and memory, for any task.
 
-Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_generation.py \
-          --sources outputs/datasets/block_grasp_source_interventions [--episodes 150] [--big 1000]
+Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_generation.py --task=block_grasp \
+          --sources outputs/datasets/block_grasp_source_interventions [--episodes 150] [--big 1000] \
+          [--demos outputs/datasets/block_grasp_source_demos]
 
-1. bare env rate: the scripted base policy stepping Block Grasp, no generator (same physics);
+1. bare env rate: the scripted base policy stepping the task, no generator (same physics);
 2. IntervenGen with 1 worker (in-process) and 2 worker processes: kept episodes/min, env steps/s;
 3. engine overhead = 1 - generator steps/s / bare steps/s (1 worker);
-4. ``--big N``: the full ``igen-generate`` command for N kept episodes with 2 workers (wall time,
+4. with ``--demos``: every mode (MimicGen from the demos, IntervenGen and the ablation from the
+   interventions) with 2 workers: generation success rate and kept episodes/min;
+5. ``--big N``: the full ``igen-generate`` command for N kept episodes with 2 workers (wall time,
    dataset write included) while sampling the peak resident memory of the whole process tree, and
    the same for N/5 episodes, to show memory does not grow with the episode count.
 """
@@ -31,7 +34,7 @@ import psutil  # noqa: E402
 def bare_env_rate(env_cfg, steps=3000) -> float:
     env, policy = env_cfg.make_task_env(), env_cfg.make_scripted_policy()
     env.reset(0)
-    env.step(np.zeros(4))
+    env.step(np.zeros(len(env.spec.action_names)))
     done, seed = 0, 0
     start = time.perf_counter()
     while done < steps:
@@ -40,7 +43,7 @@ def bare_env_rate(env_cfg, steps=3000) -> float:
             info = env.step(policy.act(obs))
             obs = env.observe()
             done += 1
-            if info.success or info.contact or done >= steps:
+            if info.success or info.mistake or done >= steps:
                 break
         seed += 1
     return steps / (time.perf_counter() - start)
@@ -95,12 +98,12 @@ class TreeMemory:
         return self.peak
 
 
-def full_command(sources: str, episodes: int) -> dict:
+def full_command(task: str, sources: str, episodes: int) -> dict:
     out = Path(tempfile.mkdtemp()) / "gen"
     cmd = [
         str(Path(sys.executable).parent / "igen-generate"),
         "--mode=igen",
-        "--task=block_grasp",
+        f"--env.type={task}",
         f"--source.root={sources}",
         f"--num_episodes={episodes}",
         "--workers=2",
@@ -127,31 +130,38 @@ def main() -> None:
     from igen_lerobot.core.env_config import task_config_class
     from igen_lerobot.datasets.reader import load_episodes
     from igen_lerobot.generation.job import GenerationJob, GenerationMode
-    from igen_lerobot.generation.sources import parse_interventions
+    from igen_lerobot.generation.sources import parse_demos, parse_interventions
 
     parser = argparse.ArgumentParser()
-    parser.add_argument("--sources", required=True)
+    parser.add_argument("--task", default="block_grasp")
+    parser.add_argument("--sources", required=True, help="an igen-collect --mode=interventions dataset")
+    parser.add_argument("--demos", help="an igen-collect --mode=demos dataset: also time every mode")
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument("--big", type=int, default=0)
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()
-    env_cfg = task_config_class("block_grasp")()
+    env_cfg = task_config_class(args.task)()
     env = env_cfg.make_task_env()
-    library = parse_interventions(
-        load_episodes(args.sources, env.spec), env.spec, env.target_pose_from_action, env.gripper_command
-    )
-    job = GenerationJob(mode=GenerationMode.IGEN, env_config=env_cfg, library=library, run_seed=0, max_steps=320)
+    spec, to_target, gripper = env.spec, env.target_pose_from_action, env.gripper_command
+    library = parse_interventions(load_episodes(args.sources, spec), spec, to_target, gripper)
+    max_steps = env_cfg.episode_length + 120  # what igen-generate gives an IntervenGen attempt
+
+    def job(mode, lib=library, cfg=env_cfg, steps=max_steps):
+        return GenerationJob(mode=mode, env_config=cfg, library=lib, run_seed=0, max_steps=steps)
+
     # interleaved repeats: this VM's speed drifts, so each ratio compares runs made side by side
     runs = []
     for _ in range(args.repeats):
+        igen = job(GenerationMode.IGEN)
         runs.append(
-            {"bare": bare_env_rate(env_cfg), "w1": run(job, args.episodes, 1), "w2": run(job, args.episodes, 2)}
+            {"bare": bare_env_rate(env_cfg), "w1": run(igen, args.episodes, 1), "w2": run(igen, args.episodes, 2)}
         )
 
     def median(get):
         return float(np.median([get(r) for r in runs]))
 
     result = {
+        "task": args.task,
         "repeats": args.repeats,
         "episodes_per_run": args.episodes,
         "bare_env_steps_per_s": median(lambda r: r["bare"]),
@@ -160,9 +170,22 @@ def main() -> None:
         "engine_overhead": median(lambda r: 1 - r["w1"]["env_steps_per_s"] / r["bare"]),
         "scaling_1_to_2": median(lambda r: r["w2"]["kept_per_min"] / r["w1"]["kept_per_min"]),
     }
+    if args.demos:
+        import dataclasses
+
+        from igen_lerobot.core.error_models import NoNoise
+
+        clean = dataclasses.replace(env_cfg, corruption=NoNoise())
+        demos = parse_demos(load_episodes(args.demos, spec), spec, to_target, gripper)
+        modes = {
+            "mimicgen": job(GenerationMode.MIMICGEN, demos, clean, env_cfg.episode_length),
+            "igen": job(GenerationMode.IGEN),
+            "igen_no_policy": job(GenerationMode.IGEN_NO_POLICY),
+        }
+        result["modes_workers_2"] = {name: run(mode_job, args.episodes, 2) for name, mode_job in modes.items()}
     if args.big:
-        result["full_small"] = full_command(args.sources, max(1, args.big // 5))
-        result["full_big"] = full_command(args.sources, args.big)
+        result["full_small"] = full_command(args.task, args.sources, max(1, args.big // 5))
+        result["full_big"] = full_command(args.task, args.sources, args.big)
     print(json.dumps(result, indent=2))
 
 

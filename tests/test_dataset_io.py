@@ -160,3 +160,36 @@ def test_plain_lerobot_dataset_without_flags_is_rejected(tmp_path, spec):
 
 def test_frame_source_names_in_features(spec):
     assert dataset_features(spec)[FRAME_SOURCE]["names"] == ["policy", "operator", "generated", "interpolation"]
+
+
+def test_a_block_grasp_dataset_written_before_the_core_held_several_tasks_still_works(tmp_path, block_grasp_env):
+    """tests/data/block_grasp_written_before_tasks: 2 interventions recorded by the release before the
+    general core (no reveal mode in its meta/igen.json). It loads, seeds generation and merges."""
+    from pathlib import Path
+
+    from igen_lerobot.core.belief import Reveal
+    from igen_lerobot.datasets.merge import merge_datasets
+    from igen_lerobot.datasets.reader import dataset_spec
+    from igen_lerobot.generation.intervengen import IntervenGenConfig, MistakeSource, generate_intervention
+    from igen_lerobot.generation.sources import parse_interventions
+
+    old = Path(__file__).parent / "data" / "block_grasp_written_before_tasks"
+    assert "reveal" not in read_igen_meta(old).meta
+    spec = dataset_spec(old)
+    assert spec.name == "block_grasp" and spec.reveal is Reveal.FULL
+    episodes = load_episodes(old, spec)
+    assert len(episodes) == 2 and all(ep.success and ep.is_intervention.any() for ep in episodes)
+    env = block_grasp_env
+    library = parse_interventions(episodes, spec, env.target_pose_from_action, env.gripper_command)
+    attempts = [
+        generate_intervention(env, None, library, IntervenGenConfig(), seed, 320, MistakeSource.REPLAY)
+        for seed in range(6)
+    ]
+    kept = [a.episode for a in attempts if a.kept]
+    assert kept, [a.reason for a in attempts]
+    new = DatasetBuilder(tmp_path / "new", "local/new", spec)
+    for i, ep in enumerate(kept):
+        new.spool.keep(i, ep)
+    new.finalize(None, {"created_by": "test"})
+    merged = merge_datasets([old, tmp_path / "new"], tmp_path / "merged", "local/merged", spec)
+    assert LeRobotDataset("local/merged", root=merged).meta.total_episodes == 2 + len(kept)
