@@ -1,4 +1,4 @@
-"""A person at LeRobot's keyboard teleoperator, driven on a virtual X display.
+"""A person at LeRobot's keyboard teleoperator, driven on a virtual X display, on every shipped task.
 
 Real parts only: Xvfb is a real X server, xdotool sends real key events through it, pynput
 (inside LeRobot's ``KeyboardEndEffectorTeleop``) receives them. The "person" holds the Up arrow
@@ -11,6 +11,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 SESSION = r"""
 import json, os, subprocess, time
@@ -23,7 +24,7 @@ from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.collection.teleop import TeleopOperator
 
 PRESS, RELEASE = 8, 20
-cfg = task_config_class("block_grasp")()
+cfg = task_config_class(os.environ["IGEN_TASK"])()
 env = cfg.make_task_env()
 teleop = KeyboardEndEffectorTeleop(KeyboardEndEffectorTeleopConfig())
 person = TeleopOperator(teleop, step_m=0.02)
@@ -56,8 +57,9 @@ print(json.dumps({"flags": episode.is_intervention.tolist(), "source": episode.s
 """
 
 
-def test_holding_a_key_takes_over_and_releasing_hands_back(x_display):
-    env = {**os.environ, "DISPLAY": x_display, "MUJOCO_GL": "egl"}
+@pytest.mark.parametrize("task", ["block_grasp", "nut_insertion"])
+def test_holding_a_key_takes_over_and_releasing_hands_back(x_display, task):
+    env = {**os.environ, "DISPLAY": x_display, "MUJOCO_GL": "egl", "IGEN_TASK": task}
     result = subprocess.run([sys.executable, "-c", SESSION], env=env, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-3000:]
     out = json.loads(result.stdout.strip().splitlines()[-1])
@@ -71,4 +73,6 @@ def test_holding_a_key_takes_over_and_releasing_hands_back(x_display):
     # LeRobot's keyboard maps Up to delta_y = -1: the person drives the goal 2 cm towards -y
     np.testing.assert_allclose(action[flags, 1], -0.02, atol=1e-6)
     np.testing.assert_allclose(action[flags, [0]], 0.0, atol=1e-6)
+    if action.shape[1] == 7:  # 6-DOF tasks: the keys move the hand's position, its orientation is held
+        np.testing.assert_allclose(action[flags, 3:6], 0.0, atol=1e-6)
     assert eef_y[20] < eef_y[8] - 0.02

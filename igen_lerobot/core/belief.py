@@ -55,15 +55,18 @@ class ObjectBelief:
         self.reveal = Reveal(self.reveal)
         self.sample = self.error_model.checked(self.sample)
 
-    def update(self, contact: bool, contact_position: np.ndarray | None, T_world_obj: np.ndarray) -> bool:
+    def update(self, contact: bool, contact_position: np.ndarray | None, T_world_obj: np.ndarray | None) -> bool:
         """Take this period's reveal-contact signal; True on the contact that reveals (the mistake).
 
         ``contact_position`` is where the contact was (the mean contact point in simulation, the
-        hand's position on a real arm); ``T_world_obj`` is the object's true (or perceived) pose.
+        hand's position on a real arm); ``T_world_obj`` is the object's true (or perceived) pose,
+        needed only by the contact that reveals.
         """
         self.contact = bool(contact)
         if not self.contact or self.revealed:
             return False
+        if T_world_obj is None:
+            raise ValueError("the contact that reveals needs the object's true pose")
         self.revealed = True
         believed = self.error_model.apply(T_world_obj, self.sample)
         self.contact_position = (

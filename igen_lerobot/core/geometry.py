@@ -13,6 +13,8 @@ Convention (used everywhere in igen-lerobot):
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
@@ -129,30 +131,33 @@ def quat_xyzw_from_matrix(rot: np.ndarray) -> np.ndarray:
 
     ``q`` and ``-q`` are the same rotation; which one a policy sees is a convention it learns.
     Observations are built with MuJoCo's (``mju_mat2Quat``: the largest component is positive),
-    here in numpy so the core, the simulator and the real robot all give the same numbers.
+    here without MuJoCo so the core, the simulator and the real robot all give the same numbers.
+    It runs on every observation, hence plain floats rather than numpy scalars.
     """
-    m = np.asarray(rot, dtype=float).reshape(9)
-    trace = m[0] + m[4] + m[8]
+    m0, m1, m2, m3, m4, m5, m6, m7, m8 = np.asarray(rot, dtype=float).reshape(9).tolist()
+    trace = m0 + m4 + m8
     if trace > 0:
-        w = 0.5 * np.sqrt(1.0 + trace)
-        q = (w, 0.25 * (m[7] - m[5]) / w, 0.25 * (m[2] - m[6]) / w, 0.25 * (m[3] - m[1]) / w)
-    elif m[0] > m[4] and m[0] > m[8]:
-        x = 0.5 * np.sqrt(1.0 + m[0] - m[4] - m[8])
-        q = (0.25 * (m[7] - m[5]) / x, x, 0.25 * (m[1] + m[3]) / x, 0.25 * (m[2] + m[6]) / x)
-    elif m[4] > m[8]:
-        y = 0.5 * np.sqrt(1.0 - m[0] + m[4] - m[8])
-        q = (0.25 * (m[2] - m[6]) / y, 0.25 * (m[1] + m[3]) / y, y, 0.25 * (m[5] + m[7]) / y)
+        w = 0.5 * math.sqrt(1.0 + trace)
+        q = (w, 0.25 * (m7 - m5) / w, 0.25 * (m2 - m6) / w, 0.25 * (m3 - m1) / w)
+    elif m0 > m4 and m0 > m8:
+        x = 0.5 * math.sqrt(1.0 + m0 - m4 - m8)
+        q = (0.25 * (m7 - m5) / x, x, 0.25 * (m1 + m3) / x, 0.25 * (m2 + m6) / x)
+    elif m4 > m8:
+        y = 0.5 * math.sqrt(1.0 - m0 + m4 - m8)
+        q = (0.25 * (m2 - m6) / y, 0.25 * (m1 + m3) / y, y, 0.25 * (m5 + m7) / y)
     else:
-        z = 0.5 * np.sqrt(1.0 - m[0] - m[4] + m[8])
-        q = (0.25 * (m[3] - m[1]) / z, 0.25 * (m[2] + m[6]) / z, 0.25 * (m[5] + m[7]) / z, z)
-    quat_wxyz = np.asarray(q) / np.linalg.norm(q)
-    return quat_wxyz[[1, 2, 3, 0]]
+        z = 0.5 * math.sqrt(1.0 - m0 - m4 + m8)
+        q = (0.25 * (m3 - m1) / z, 0.25 * (m2 + m6) / z, 0.25 * (m5 + m7) / z, z)
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return np.array((q[1] / norm, q[2] / norm, q[3] / norm, q[0] / norm))
 
 
 def pose_vector(pose: np.ndarray) -> np.ndarray:
     """Position [m] + quaternion xyzw (MuJoCo's sign) of a 4x4 pose: the 7 numbers observations hold."""
-    pose = np.asarray(pose, dtype=float)
-    return np.concatenate([pose[:3, 3], quat_xyzw_from_matrix(pose[:3, :3])])
+    out = np.empty(7)
+    out[:3] = pose[:3, 3]
+    out[3:] = quat_xyzw_from_matrix(pose[:3, :3])
+    return out
 
 
 def rotvec_from_matrix(rot: np.ndarray) -> np.ndarray:

@@ -100,6 +100,12 @@ def check_features(features: dict[str, dict], spec: TaskSpec, root: Path, flag: 
                 f"{flag}={root}: feature {key!r} has shape {got}, task {spec.name!r} needs {want}"
                 + _layout_hint(key, features[key].get("names"), expected[key]["names"])
             )
+        names = features[key].get("names")
+        if key in (OBS_STATE, OBS_ENV_STATE, ACTION, CORRUPTION) and names and list(names) != expected[key]["names"]:
+            raise DatasetSchemaError(
+                f"{flag}={root}: feature {key!r} holds {list(names)}, task {spec.name!r} needs "
+                f"{expected[key]['names']}" + _layout_hint(key, names, expected[key]["names"])
+            )
 
 
 def _layout_hint(key: str, got: list | None, want: list | None) -> str:

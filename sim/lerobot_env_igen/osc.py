@@ -118,22 +118,43 @@ class OperationalSpaceController:
         self._jacp = np.zeros((3, model.nv))
         self._jacr = np.zeros((3, model.nv))
         self._mass_full = np.zeros((model.nv, model.nv))
+        self._bound: mujoco.MjData | None = None
+        self._bound_views: tuple = ()
+
+    def _views(self, data: mujoco.MjData) -> tuple:
+        """Views into ``data``'s buffers (they live as long as ``data``), built once per MjData.
+
+        Each attribute access on an MjData builds a fresh numpy view; at 25 substeps per control
+        step those accesses cost more than the arithmetic, so they are made once.
+        """
+        if self._bound is not data:
+            self._bound = data
+            self._bound_views = (
+                data.qM,
+                data.qvel,
+                data.qpos[self._qpos],
+                data.qfrc_bias,
+                data.site_xpos[self._site],
+                data.site_xmat[self._site].reshape(3, 3),
+            )
+        return self._bound_views
 
     def torques(self, data: mujoco.MjData, goal_pos: np.ndarray, goal_rot: np.ndarray) -> np.ndarray:
         """Joint torques for the arm given the current kinematics in ``data`` (after ``mj_step1``)."""
+        qM, qvel, qpos, qfrc_bias, site_pos, site_rot = self._views(data)
         mujoco.mj_jacSite(self._model, data, self._jacp, self._jacr, self._site)
-        mujoco.mj_fullM(self._model, self._mass_full, data.qM)
+        mujoco.mj_fullM(self._model, self._mass_full, qM)
         return _osc_kernel(
             self._jacp,
             self._jacr,
             self._mass_full,
             self._d0,
             self._n,
-            data.qvel,
-            data.qpos[self._qpos],
-            data.qfrc_bias,
-            data.site_xpos[self._site],
-            data.site_xmat[self._site].reshape(3, 3),
+            qvel,
+            qpos,
+            qfrc_bias,
+            site_pos,
+            site_rot,
             goal_pos,
             goal_rot,
             self._kp,

@@ -200,15 +200,21 @@ class PandaArm:
         step = GRIPPER_RATE if close_gripper else -GRIPPER_RATE
         self._gripper_level = min(1.0, max(-1.0, self._gripper_level + step))
         self._apply_gripper_ctrl()
+        # the substep loop runs 25 times per period: everything it touches is bound locally
         model, data, act = self.model, self.data, self.arm_act
+        torques, goal_pos, goal_rot = self.osc.torques, self.goal_pos, self.goal_rot
+        step1, step2 = mujoco.mj_step1, mujoco.mj_step2
+        mask_a, mask_b = watch if watch is not None else (None, None)
         event: ContactEvent | None = None
+        watching = watch is not None
         self.peak_contact_force = 0.0
         for _ in range(self.substeps):
-            mujoco.mj_step1(model, data)
-            data.ctrl[act] = self.osc.torques(data, self.goal_pos, self.goal_rot)
-            mujoco.mj_step2(model, data)
-            if watch is not None and event is None and data.ncon:
-                event = self._first_contact(*watch)
+            step1(model, data)
+            data.ctrl[act] = torques(data, goal_pos, goal_rot)
+            step2(model, data)
+            if watching and data.ncon and _any_pair(data.contact.geom[: data.ncon], mask_a, mask_b):
+                event = self._first_contact(mask_a, mask_b)
+                watching = False
             if measure_force:
                 self.peak_contact_force = max(self.peak_contact_force, self.contact_force())
         return event

@@ -82,9 +82,10 @@ class PandaTaskEnv(TaskEnv):
         return [g for g in range(model.ngeom) if model.geom_bodyid[g] == body and model.geom_contype[g]]
 
     def body_pose(self, body: int) -> np.ndarray:
-        pose = np.eye(4)
+        pose = np.zeros((4, 4))
         pose[:3, :3] = self.data.xmat[body].reshape(3, 3)
         pose[:3, 3] = self.data.xpos[body]
+        pose[3, 3] = 1.0
         return pose
 
     def set_free_pose(self, name: str, pos: np.ndarray, quat_wxyz: np.ndarray = (1.0, 0.0, 0.0, 0.0)) -> None:
@@ -172,7 +173,9 @@ class PandaTaskEnv(TaskEnv):
         self._steps += 1
         revealed_now = False
         if self._reveal_watch is not None:
-            T_true = self.true_object_poses()[self.spec.corrupted_object]
+            # the true pose matters only to the contact that reveals: skip it on every other step
+            reveals = event is not None and not self.belief.revealed
+            T_true = self.body_pose(self.bodies[self.spec.corrupted_object]) if reveals else None
             revealed_now = self.belief.update(event is not None, None if event is None else event.position, T_true)
             if revealed_now:
                 self.last_reveal_contact = event
