@@ -13,7 +13,7 @@ import numpy as np
 
 from igen_lerobot.core.task import TaskEnv
 
-__all__ = ["Policy", "Operator"]
+__all__ = ["Policy", "Operator", "TakeoverOperator"]
 
 
 @runtime_checkable
@@ -47,3 +47,26 @@ class Operator(abc.ABC):
 
     def close(self) -> None:  # noqa: B027 - optional hook
         """Release devices."""
+
+
+class TakeoverOperator(Operator):
+    """A scripted stand-in for a person: takes over at the first sign of a mistake and keeps control.
+
+    Subclasses say what a mistake looks like (:meth:`judges_mistake`, from the true poses); a
+    policy that has not finished after ``patience_steps`` (it wanders) is taken over too.
+    """
+
+    def __init__(self, patience_steps: int) -> None:
+        self.patience_steps = patience_steps
+        self._watched = 0
+
+    def reset(self, env: TaskEnv) -> None:
+        self._watched = 0
+
+    @abc.abstractmethod
+    def judges_mistake(self, env: TaskEnv) -> bool:
+        """Whether the policy is making a mistake now, as a person watching with the true poses would judge."""
+
+    def wants_control(self, env: TaskEnv, in_control: bool) -> bool:
+        self._watched += 1
+        return in_control or self.judges_mistake(env) or self._watched > self.patience_steps

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.core.agents import Operator
+from igen_lerobot.core.agents import TakeoverOperator
 from igen_lerobot.core.task import TaskEnv
 from lerobot_env_igen.block_grasp.env import CUBE_HALF, BlockGraspEnv
 
@@ -81,7 +81,7 @@ class ScriptedGraspPolicy:
         return self.rule.act(state[:3].astype(float), float(state[7]), env_state[:3].astype(float))
 
 
-class ScriptedGraspOperator(Operator):
+class ScriptedGraspOperator(TakeoverOperator):
     """Operator that sees the true cube pose.
 
     Takes over (and keeps control to the end of the episode) at the first sign of a mistake:
@@ -92,13 +92,9 @@ class ScriptedGraspOperator(Operator):
     """
 
     def __init__(self, rule: GraspRule | None = None, mistake_xy: float = 0.010, patience_steps: int = 100) -> None:
+        super().__init__(patience_steps)
         self.rule = rule or GraspRule()
         self.mistake_xy = mistake_xy
-        self.patience_steps = patience_steps
-        self._watched = 0
-
-    def reset(self, env: TaskEnv) -> None:
-        self._watched = 0
 
     def judges_mistake(self, env: BlockGraspEnv) -> bool:
         eef = env.eef_pose()[:3, 3]
@@ -107,10 +103,6 @@ class ScriptedGraspOperator(Operator):
         below_top = eef[2] < cube[2] + CUBE_HALF + 0.01
         closing = env.gripper_width() < GRIPPER_OPEN_WIDTH
         return off_axis and (env.contact or closing or below_top)
-
-    def wants_control(self, env: TaskEnv, in_control: bool) -> bool:
-        self._watched += 1
-        return in_control or self.judges_mistake(env) or self._watched > self.patience_steps
 
     def act(self, env: TaskEnv) -> np.ndarray:
         eef = env.eef_pose()[:3, 3]

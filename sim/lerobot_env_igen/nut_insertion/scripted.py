@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.core.agents import Operator
+from igen_lerobot.core.agents import TakeoverOperator
 from igen_lerobot.core.geometry import make_pose, pos_quat_to_pose
 from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE, TaskEnv
 from lerobot_env_igen.nut_insertion.spec import NUT_HALF_THICKNESS, PEG_HALF, TABLE_TOP_Z
@@ -88,7 +88,7 @@ class ScriptedInsertionPolicy:
         return self.actions.action_towards(T_world_eef, target, close)
 
 
-class ScriptedInsertionOperator(Operator):
+class ScriptedInsertionOperator(TakeoverOperator):
     """Operator that sees the true peg pose.
 
     Takes over (and keeps control to the end of the episode) once the nut has touched the peg
@@ -99,13 +99,9 @@ class ScriptedInsertionOperator(Operator):
     """
 
     def __init__(self, rule: InsertionRule | None = None, mistake_xy: float = 0.006, patience_steps: int = 150) -> None:
+        super().__init__(patience_steps)
         self.rule = rule or InsertionRule()
         self.mistake_xy = mistake_xy
-        self.patience_steps = patience_steps
-        self._watched = 0
-
-    def reset(self, env: TaskEnv) -> None:
-        self._watched = 0
 
     def judges_mistake(self, env: TaskEnv) -> bool:
         poses = env.true_object_poses()
@@ -113,10 +109,6 @@ class ScriptedInsertionOperator(Operator):
         off_axis = float(np.linalg.norm(nut[:2] - peg[:2])) > self.mistake_xy
         below_top = nut[2] - NUT_HALF_THICKNESS < peg[2] + PEG_HALF[2] - 0.01
         return off_axis and (env.contact or below_top)
-
-    def wants_control(self, env: TaskEnv, in_control: bool) -> bool:
-        self._watched += 1
-        return in_control or self.judges_mistake(env) or self._watched > self.patience_steps
 
     def act(self, env: TaskEnv) -> np.ndarray:
         poses = env.true_object_poses()
