@@ -147,7 +147,7 @@ def test_plain_lerobot_dataset_without_flags_is_rejected(tmp_path, spec):
     features = {k: v for k, v in dataset_features(spec).items() if not k.startswith("complementary_info")}
     ds = LeRobotDataset.create("local/plain", fps=20, features=features, root=tmp_path / "plain", use_videos=False)
     for _ in range(3):
-        ds.add_frame({k: np.zeros(v["shape"], dtype=np.float32) for k, v in features.items()} | {"task": "x"})
+        ds.add_frame({k: np.zeros(v["shape"], dtype=v["dtype"]) for k, v in features.items()} | {"task": "x"})
     ds.save_episode()
     ds.finalize()
     with pytest.raises(DatasetSchemaError, match="igen metadata"):
@@ -191,5 +191,41 @@ def test_a_block_grasp_dataset_written_before_the_core_held_several_tasks_still_
     for i, ep in enumerate(kept):
         new.spool.keep(i, ep)
     new.finalize(None, {"created_by": "test"})
+    # the old dataset predates LeRobot's RL columns: the merge rewrites it with them, the input untouched
     merged = merge_datasets([old, tmp_path / "new"], tmp_path / "merged", "local/merged", spec)
-    assert LeRobotDataset("local/merged", root=merged).meta.total_episodes == 2 + len(kept)
+    dataset = LeRobotDataset("local/merged", root=merged)
+    assert dataset.meta.total_episodes == 2 + len(kept)
+    rewards = np.array(dataset.hf_dataset["next.reward"]).reshape(-1)
+    assert rewards.sum() == 2 + len(kept)  # one per successful episode, the old ones included
+    assert "next.reward" not in json.loads((old / "meta" / "info.json").read_text())["features"]
+
+
+def test_lerobots_rl_replay_buffer_loads_our_dataset_with_the_intervention_flags(tmp_path, spec):
+    """next.reward / next.done follow LeRobot's RL conventions: LeRobot's own ReplayBuffer loads us."""
+    import torch
+    from lerobot.rl.buffer import ReplayBuffer
+
+    from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE
+    from igen_lerobot.datasets.schema import DONE, REWARD
+
+    rng = np.random.default_rng(0)
+    episodes = [synthetic_episode(spec, rng, length=12, seed=1), synthetic_episode(spec, rng, length=9, seed=2)]
+    episodes[1].success = False
+    builder = DatasetBuilder(tmp_path / "rl", "local/rl", spec)
+    for i, ep in enumerate(episodes):
+        builder.spool.keep(i, ep)
+    builder.finalize(None, {"created_by": "test"})
+    dataset = LeRobotDataset("local/rl", root=tmp_path / "rl")
+    assert dataset.meta.features[REWARD]["dtype"] == "float32" and dataset.meta.features[DONE]["dtype"] == "bool"
+    buffer = ReplayBuffer.from_lerobot_dataset(
+        dataset, device="cpu", state_keys=[OBS_STATE, OBS_ENV_STATE], use_drq=False
+    )
+    assert buffer.size == 21
+    np.testing.assert_array_equal(buffer.rewards[:21].numpy(), np.eye(21)[11])  # 1.0 on the success frame only
+    dones = np.zeros(21, dtype=bool)
+    dones[[11, 20]] = True  # the last frame of each episode, failed or not
+    np.testing.assert_array_equal(buffer.dones[:21].numpy(), dones)
+    flags = np.concatenate([ep.is_intervention for ep in episodes])
+    np.testing.assert_array_equal(buffer.complementary_info["is_intervention"][:21].reshape(-1).numpy(), flags)
+    sampled = buffer.sample(64)["complementary_info"]["is_intervention"]  # the buffer stores flags as 0/1 floats
+    assert len(sampled) > 0 and set(torch.unique(sampled).tolist()) <= {0.0, 1.0}

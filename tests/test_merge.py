@@ -72,7 +72,7 @@ def test_merge_rejects_empty_and_flagless_datasets(source_demos, tmp_path):
 
     features = {k: v for k, v in dataset_features(SPEC).items() if not k.startswith("complementary_info")}
     plain = LeRobotDataset.create("local/plain", fps=20, features=features, root=tmp_path / "plain", use_videos=False)
-    plain.add_frame({k: np.zeros(v["shape"], dtype=np.float32) for k, v in features.items()} | {"task": "x"})
+    plain.add_frame({k: np.zeros(v["shape"], dtype=v["dtype"]) for k, v in features.items()} | {"task": "x"})
     plain.save_episode()
     plain.finalize()
     flagless = _merge(f"--inputs=[{source_demos},{tmp_path / 'plain'}]", f"--dataset.root={tmp_path / 'a'}")

@@ -21,8 +21,8 @@ from igen_lerobot.core.exceptions import ConfigError, TaskMismatchError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_merge import MergeConfig
 from igen_lerobot.datasets.reader import check_features, dataset_spec, read_igen_meta
-from igen_lerobot.datasets.schema import SCHEMA_VERSION
-from igen_lerobot.datasets.writer import IGEN_META_FILE
+from igen_lerobot.datasets.schema import RL_COLUMNS, SCHEMA_VERSION
+from igen_lerobot.datasets.writer import IGEN_META_FILE, write_lerobot_dataset
 
 logger = logging.getLogger(__name__)
 
@@ -64,7 +64,7 @@ def merge_datasets(
     output_root = Path(output_root)
     if output_root.exists() and not overwrite:
         raise ConfigError(f"{output_root} exists; pick another output or pass overwrite")
-    metas, frames = [], []
+    metas, frames, outdated = [], [], []
     for root in roots:
         info = read_igen_meta(root, "--inputs")
         if info.task != spec.name:
@@ -81,13 +81,20 @@ def merge_datasets(
             raise ConfigError(f"cannot merge {root}: it holds no episodes")
         metas.append(info.meta)
         frames.append(lerobot_meta.total_frames)
+        outdated.append(not all(key in lerobot_meta.features for key in RL_COLUMNS))
     repeats = weighted_repeats(frames, weights) if weights is not None else [1] * len(roots)
     work = output_root.with_name(output_root.name + ".partial")
     if work.exists():
         shutil.rmtree(work)
     work.mkdir(parents=True)
     build = work / "lerobot"
-    parts = [(r, n) for r, n in zip(roots, repeats, strict=True) for _ in range(n)]
+    # LeRobot aggregates datasets of equal features only: one written before next.reward/next.done
+    # is rewritten with them (into the work folder; the input stays as it is)
+    sources = [
+        _with_rl_columns(root, spec, work / f"upgraded_{i}") if old else root
+        for i, (root, old) in enumerate(zip(roots, outdated, strict=True))
+    ]
+    parts = [(r, n) for r, n in zip(sources, repeats, strict=True) for _ in range(n)]
     aggregate_datasets(
         repo_ids=[f"local/{r.name}" for r, _ in parts],
         aggr_repo_id=repo_id,
@@ -134,3 +141,17 @@ def run_merge(cfg: MergeConfig) -> Path:
     )
     print(f"Merged {len(cfg.inputs)} datasets into {merged}")
     return merged
+
+
+def _with_rl_columns(root: Path, spec: TaskSpec, into: Path) -> Path:
+    """A copy of the dataset at ``root`` in the current schema (LeRobot's RL columns added)."""
+    from igen_lerobot.datasets.reader import load_episodes
+
+    logger.info("%s predates next.reward/next.done: rewriting it with them for the merge", root)
+    episodes = load_episodes(root, spec, flag="--inputs")
+    old = read_igen_meta(root).meta
+    meta = {**old, "upgraded_from_schema": old.get("schema_version")}
+    write_lerobot_dataset(
+        into, f"local/{root.name}", spec, episodes, len(episodes), meta, desc=f"upgrading {root.name}"
+    )
+    return into

@@ -19,6 +19,12 @@ every frame of the episode for the same reason.
 | complementary_info.episode_seed | int64 (1,) | seed that reproduces the scene and the corruption |
 | complementary_info.episode_kind | int64 (1,) | demo / intervention / mimicgen / igen / igen_no_policy (index) |
 | complementary_info.success | bool (1,) | whether the episode ended in success |
+| next.reward | float32 (1,) | LeRobot's RL reward: 1.0 on the last frame of a successful episode, else 0 |
+| next.done | bool (1,) | LeRobot's RL episode end: True on the last frame |
+
+``next.reward`` and ``next.done`` follow LeRobot's RL conventions (``lerobot.rl.buffer.ReplayBuffer``
+loads igen datasets with the intervention flags carried over as complementary info). Datasets
+written before they existed (schema version 1) lack them and still load.
 """
 
 from __future__ import annotations
@@ -30,7 +36,7 @@ import numpy as np
 from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, FrameSource, TaskSpec
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2  # 2: next.reward and next.done
 IS_INTERVENTION = "complementary_info.is_intervention"
 FRAME_SOURCE = "complementary_info.frame_source"
 SUBTASK_INDEX = "complementary_info.subtask_index"
@@ -39,6 +45,10 @@ CORRUPTION = "complementary_info.corruption"
 EPISODE_SEED = "complementary_info.episode_seed"
 EPISODE_KIND = "complementary_info.episode_kind"
 EPISODE_SUCCESS = "complementary_info.success"
+
+REWARD = "next.reward"
+DONE = "next.done"
+RL_COLUMNS = (REWARD, DONE)
 
 IGEN_COLUMNS = (
     IS_INTERVENTION,
@@ -70,6 +80,8 @@ def dataset_features(spec: TaskSpec) -> dict[str, dict]:
         EPISODE_SEED: {"dtype": "int64", "shape": (1,), "names": None},
         EPISODE_KIND: {"dtype": "int64", "shape": (1,), "names": list(EpisodeKind.ALL)},
         EPISODE_SUCCESS: {"dtype": "bool", "shape": (1,), "names": None},
+        REWARD: {"dtype": "float32", "shape": (1,), "names": None},
+        DONE: {"dtype": "bool", "shape": (1,), "names": None},
     }
 
 
@@ -80,6 +92,7 @@ def episode_frames(episode: Episode, spec: TaskSpec) -> Iterator[dict]:
     seed = np.array([episode.seed], dtype=np.int64)
     kind = np.array([EpisodeKind.ALL.index(episode.kind)], dtype=np.int64)
     success = np.array([episode.success], dtype=bool)
+    last = episode.length - 1
     for t in range(episode.length):
         yield {
             OBS_STATE: episode.state[t].astype(np.float32),
@@ -93,5 +106,7 @@ def episode_frames(episode: Episode, spec: TaskSpec) -> Iterator[dict]:
             EPISODE_SEED: seed,
             EPISODE_KIND: kind,
             EPISODE_SUCCESS: success,
+            REWARD: np.array([1.0 if episode.success and t == last else 0.0], dtype=np.float32),
+            DONE: np.array([t == last]),
             "task": spec.instruction,
         }

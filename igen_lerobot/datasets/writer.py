@@ -12,12 +12,13 @@ import json
 import logging
 import shutil
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 from tqdm import tqdm
 
+from igen_lerobot.core.episode import Episode
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.schema import SCHEMA_VERSION, dataset_features, episode_frames
@@ -93,48 +94,16 @@ class DatasetBuilder:
 
     def finalize(self, num_episodes: int | None, metadata: dict, fast_write: bool = True) -> BuildSummary:
         """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at ``root``."""
-        from lerobot.datasets.lerobot_dataset import LeRobotDataset
-
-        import datasets
-
-        datasets.disable_progress_bars()  # one bar per episode otherwise; ours covers the whole write
-
         start = time.perf_counter()
         kept = self.spool.kept_attempts()
         count = len(kept) if num_episodes is None else min(num_episodes, len(kept))
         if count == 0:
             raise ConfigError(f"no episode was kept in {self.spool.directory}; nothing to write")
         build_dir = self.work_dir / "lerobot"
-        if build_dir.exists():
-            shutil.rmtree(build_dir)  # a build interrupted earlier: start it over from the spool
-        features = dataset_features(self.spec)
-        dataset = LeRobotDataset.create(
-            repo_id=self.repo_id,
-            fps=self.spec.fps,
-            features=features,
-            root=build_dir,
-            robot_type=self.spec.robot_type,
-            use_videos=False,
+        episodes = (episode for _, episode in self.spool.iter_kept(count))
+        frames, _ = write_lerobot_dataset(
+            build_dir, self.repo_id, self.spec, episodes, count, metadata, fast_write=fast_write
         )
-        frames = 0
-        kinds: dict[str, int] = {}
-        skip = _image_embedding_skipped(features) if fast_write else contextlib.nullcontext()
-        with skip:
-            for _, episode in tqdm(self.spool.iter_kept(count), total=count, desc="writing dataset", unit="ep"):
-                for frame in episode_frames(episode, self.spec):
-                    dataset.add_frame(frame)
-                dataset.save_episode()
-                frames += episode.length
-                kinds[episode.kind] = kinds.get(episode.kind, 0) + 1
-        dataset.finalize()
-        meta = {
-            "schema_version": SCHEMA_VERSION,
-            "task": self.spec.name,
-            "reveal": self.spec.reveal.value,
-            "episode_kinds": kinds,
-            **metadata,
-        }
-        (build_dir / IGEN_META_FILE).write_text(json.dumps(meta, indent=2, default=str))
         self._publish(build_dir)
         seconds = time.perf_counter() - start
         logger.info("wrote %d episodes (%d frames) to %s in %.1f s", count, frames, self.root, seconds)
@@ -152,3 +121,47 @@ class DatasetBuilder:
         if old is not None:
             shutil.rmtree(old)
         shutil.rmtree(self.work_dir)
+
+
+def write_lerobot_dataset(
+    build_dir: Path,
+    repo_id: str,
+    spec: TaskSpec,
+    episodes: Iterable[Episode],
+    total: int,
+    metadata: dict,
+    fast_write: bool = True,
+    desc: str = "writing dataset",
+) -> tuple[int, dict[str, int]]:
+    """Write ``episodes`` as a fresh LeRobot dataset with igen's metadata; returns (frames, episodes per kind).
+
+    ``build_dir`` is replaced if it exists (an earlier build that was interrupted): callers write
+    into a work folder and move the result into place only once this returns.
+    """
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    import datasets
+
+    datasets.disable_progress_bars()  # one bar per episode otherwise; ours covers the whole write
+    build_dir = Path(build_dir)
+    if build_dir.exists():
+        shutil.rmtree(build_dir)
+    features = dataset_features(spec)
+    dataset = LeRobotDataset.create(
+        repo_id=repo_id, fps=spec.fps, features=features, root=build_dir, robot_type=spec.robot_type, use_videos=False
+    )
+    frames = 0
+    kinds: dict[str, int] = {}
+    skip = _image_embedding_skipped(features) if fast_write else contextlib.nullcontext()
+    with skip:
+        for episode in tqdm(episodes, total=total, desc=desc, unit="ep"):
+            for frame in episode_frames(episode, spec):
+                dataset.add_frame(frame)
+            dataset.save_episode()
+            frames += episode.length
+            kinds[episode.kind] = kinds.get(episode.kind, 0) + 1
+    dataset.finalize()
+    meta = {"schema_version": SCHEMA_VERSION, "task": spec.name, "reveal": spec.reveal.value, **metadata}
+    meta["episode_kinds"] = kinds
+    (build_dir / IGEN_META_FILE).write_text(json.dumps(meta, indent=2, default=str))
+    return frames, kinds
