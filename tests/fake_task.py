@@ -274,6 +274,9 @@ class FakePickPlaceConfig(TaskEnvConfig):
     fps: int = 20
     corruption: ErrorModel = field(default_factory=lambda: BoxNoise((0.03, 0.03, 0.0), (0.02, 0.02, 0.0)))
 
+    def make_action_space(self) -> DeltaPoseActions:
+        return DeltaPoseActions(max_delta=0.03, max_rotation=0.2)
+
     def make_task_env(self) -> TaskEnv:
         return FakePickPlaceEnv(self.corruption, self.reveal)
 

@@ -18,6 +18,7 @@ from typing import ClassVar
 from lerobot.configs import FeatureType, PolicyFeature
 from lerobot.envs.configs import EnvConfig
 
+from igen_lerobot.core.actions import ActionSpace
 from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import ErrorModel, NoNoise
@@ -115,6 +116,10 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
     def paper_table(self) -> PaperTable | None:
         """The paper's table for this reveal mode, if the paper has one."""
         return next((t for t in self.paper_tables if t.reveal is self.reveal), None)
+
+    @abc.abstractmethod
+    def make_action_space(self) -> ActionSpace:
+        """The task's action space under this config (cheap: no simulator is built)."""
 
     @abc.abstractmethod
     def make_task_env(self) -> TaskEnv:

@@ -93,11 +93,10 @@ def generate(cfg: GenerateConfig) -> None:
     spec = env_cfg.task_spec
     source_root = Path(cfg.source.root)
     episodes = load_episodes(source_root, spec, repo_id=cfg.source.repo_id, flag="--source.root")
-    probe = env_cfg.make_task_env()  # only its action <-> target conversion is used here
+    actions = env_cfg.make_action_space()
     parse = parse_demos if mode is GenerationMode.MIMICGEN else parse_interventions
     check_source_kinds(episodes, mode, source_root)
-    library = parse(episodes, spec, probe.target_pose_from_action, probe.gripper_command)
-    probe.close()
+    library = parse(episodes, spec, actions.target_pose, actions.gripper_closed)
     check_sources_cover(library, mode, source_root)
     if mode is GenerationMode.IGEN:
         check_policy_source(cfg.policy, env_cfg)  # a checkpoint of another task fails here, before any work

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from lerobot.envs.configs import EnvConfig
 
+from igen_lerobot.core.actions import ActionSpace, DeltaPositionActions
 from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.env_config import TaskEnvConfig
@@ -39,6 +40,9 @@ class BlockGraspEnvConfig(TaskEnvConfig):
     corruption: ErrorModel = field(default_factory=paper_corruption)
     cube_region: tuple[float, float] = (0.20, 0.30)  # [m] x, y extents of the cube's start region
     max_delta: float = 0.03  # [m] per-step clip on the commanded end-effector displacement
+
+    def make_action_space(self) -> ActionSpace:
+        return DeltaPositionActions(max_delta=self.max_delta)
 
     def make_task_env(self) -> TaskEnv:
         from lerobot_env_igen.block_grasp.env import BlockGraspEnv

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from lerobot.envs.configs import EnvConfig
 
+from igen_lerobot.core.actions import ActionSpace, DeltaPoseActions
 from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.env_config import TaskEnvConfig
@@ -55,6 +56,9 @@ class NutInsertionEnvConfig(TaskEnvConfig):
     peg_region: tuple[float, float] = (0.10, 0.10)  # [m] x, y extents of the peg's region
     max_delta: float = 0.03  # [m] per-step clip on the commanded end-effector displacement
     max_rotation: float = 0.2  # [rad] per-step clip on the commanded end-effector rotation
+
+    def make_action_space(self) -> ActionSpace:
+        return DeltaPoseActions(max_delta=self.max_delta, max_rotation=self.max_rotation)
 
     def make_task_env(self) -> TaskEnv:
         from lerobot_env_igen.nut_insertion.env import NutInsertionEnv
