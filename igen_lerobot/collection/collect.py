@@ -104,3 +104,4 @@ def collect(cfg: CollectConfig) -> None:
         },
     )
     print(f"Wrote {summary.episodes} {cfg.mode} episodes ({summary.frames} frames) to {summary.root}")
+    cfg.dataset.publish(summary.root)

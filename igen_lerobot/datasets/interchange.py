@@ -43,6 +43,7 @@ def import_dataset(cfg: ImportConfig) -> dict:
     frames = sum(ep.length for ep in episodes)
     seconds = time.perf_counter() - start
     print(f"Imported {summary.episodes} episodes ({frames} frames) from {cfg.input} into {summary.root}")
+    cfg.dataset.publish(summary.root)
     return {"episodes": summary.episodes, "frames": frames, "read_s": read_s, "seconds": seconds, "root": str(root)}
 
 

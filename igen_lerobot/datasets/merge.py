@@ -140,6 +140,7 @@ def run_merge(cfg: MergeConfig) -> Path:
         [Path(p) for p in cfg.inputs], root, repo_id, spec, overwrite=cfg.dataset.overwrite, weights=cfg.weights
     )
     print(f"Merged {len(cfg.inputs)} datasets into {merged}")
+    cfg.dataset.publish(merged)
     return merged
 
 

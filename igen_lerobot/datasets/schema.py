@@ -50,6 +50,28 @@ REWARD = "next.reward"
 DONE = "next.done"
 RL_COLUMNS = (REWARD, DONE)
 
+# what each column beyond the policy's inputs means (the dataset card's table)
+SCHEMA_DOC_ROWS = (
+    ("`complementary_info.is_intervention`", "bool (1)", "an operator, or a replayed recovery, produced this action"),
+    ("`complementary_info.frame_source`", "int64 (1)", "0 policy, 1 operator, 2 generated, 3 generated interpolation"),
+    ("`complementary_info.subtask_index`", "int64 (1)", "the object-centric subtask the frame belongs to"),
+    (
+        "`complementary_info.true_object_pose`",
+        "float32 (7 per object)",
+        "**privileged** true object poses (position + quaternion xyzw): never a policy input",
+    ),
+    ("`complementary_info.corruption`", "float32", "the episode's observation error sample, named by its model"),
+    ("`complementary_info.episode_seed`", "int64 (1)", "the seed that reproduces the scene and the error"),
+    (
+        "`complementary_info.episode_kind`",
+        "int64 (1)",
+        "index into (demo, intervention, mimicgen, igen, igen_no_policy)",
+    ),
+    ("`complementary_info.success`", "bool (1)", "whether the episode ended in success"),
+    ("`next.reward`", "float32 (1)", "LeRobot's RL reward: 1.0 on a successful episode's last frame, else 0"),
+    ("`next.done`", "bool (1)", "LeRobot's RL episode end: true on the last frame"),
+)
+
 IGEN_COLUMNS = (
     IS_INTERVENTION,
     FRAME_SOURCE,

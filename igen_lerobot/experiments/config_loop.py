@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
 from igen_lerobot.generation.intervengen import IntervenGenConfig
 from igen_lerobot.training.config_train import TrainConfig
 
@@ -26,6 +27,8 @@ class LoopConfig:
     igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
     train_final: bool = True  # also train the policy on the final D
     output_dir: str = "outputs/loop"
+    # --dataset.push_to_hub=true --dataset.repo_id=user/name pushes the final D (it lives under output_dir)
+    dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
 
     def __post_init__(self) -> None:
         task_config_class(self.task)  # a clear error for an unknown task, before any work
@@ -34,5 +37,10 @@ class LoopConfig:
         for name in ("iterations", "interventions", "generated", "workers"):
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
+        if self.dataset.root or self.dataset.overwrite:
+            raise ConfigError(
+                "igen-loop writes its datasets under --output_dir; --dataset takes only push_to_hub, repo_id, "
+                "private and branch (for the final dataset)"
+            )
         if self.operator != "scripted":
             raise ConfigError("--operator must be 'scripted' in igen-loop; record a person with igen-collect")

@@ -97,4 +97,5 @@ def loop_command(cfg: LoopConfig) -> dict:
     """``igen-loop``: run the iterations and print what they produced."""
     produced = run_loop(cfg)
     print(json.dumps(produced, indent=2))
+    cfg.dataset.publish(Path(produced["dataset"]))
     return produced

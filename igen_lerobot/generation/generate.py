@@ -155,6 +155,7 @@ def generate(cfg: GenerateConfig) -> None:
         },
     )
     print(f"Wrote {summary.episodes} {mode.value} episodes ({summary.frames} frames) to {summary.root}")
+    cfg.dataset.publish(summary.root)
     if cfg.merge_with:
         merged = root.with_name(root.name + "_merged")
         merge_datasets([Path(cfg.merge_with), root], merged, f"{repo_id}_merged", spec, overwrite=cfg.dataset.overwrite)

@@ -1,0 +1,197 @@
+"""The dataset card pushed with every igen dataset: what the data is, how it was made, what to trust.
+
+LeRobot's own card template frames it (its front matter: LeRobot tag, robotics category, the
+parquet config, the license; ``meta/info.json`` as the structure); everything a person needs to
+judge the data goes into the template's description and citation fields, built from the dataset's
+own files (``meta/info.json``, ``meta/igen.json``) and the task's spec.
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+from pathlib import Path
+
+from igen_lerobot.core.task import TaskSpec
+from igen_lerobot.datasets.schema import SCHEMA_DOC_ROWS
+
+__all__ = ["card_fields", "CARD_TAGS", "PAPER_URL", "CITATIONS"]
+
+PAPER_URL = "https://arxiv.org/abs/2405.01472"
+HOMEPAGE = "https://sites.google.com/view/intervengen2024"
+CARD_TAGS = ("synthetic", "simulation", "intervengen", "mimicgen", "interventions", "imitation-learning")
+CITATIONS = """@inproceedings{hoque2024intervengen,
+  title     = {IntervenGen: Interventional Data Generation for Robust and Data-Efficient Robot Imitation Learning},
+  author    = {Hoque, Ryan and Mandlekar, Ajay and Garrett, Caelan and Goldberg, Ken and Fox, Dieter},
+  booktitle = {IEEE/RSJ International Conference on Intelligent Robots and Systems (IROS)},
+  year      = {2024},
+  eprint    = {2405.01472},
+  archivePrefix = {arXiv}
+}
+
+@inproceedings{mandlekar2023mimicgen,
+  title     = {MimicGen: A Data Generation System for Scalable Robot Learning using Human Demonstrations},
+  author    = {Mandlekar, Ajay and Nasiriany, Soroush and Wen, Bowen and Akinola, Iretiayo and Narang, Yashraj
+               and Fan, Linxi and Zhu, Yuke and Fox, Dieter},
+  booktitle = {Conference on Robot Learning (CoRL)},
+  year      = {2023},
+  eprint    = {2310.17596},
+  archivePrefix = {arXiv}
+}
+
+@misc{cadene2024lerobot,
+  title        = {LeRobot: State-of-the-art Machine Learning for Real-World Robotics in Pytorch},
+  author       = {Cadene, Remi and Alibert, Simon and Soare, Alexander and Gallouedec, Quentin and Zouitine, Adil
+                  and Palma, Steven and Kooijmans, Pepijn and Aractingi, Michel and Shukor, Mustafa
+                  and Aubakirova, Dana and Russi, Martino and Capuano, Francesco and Pascal, Caroline
+                  and Choghari, Jade and Moss, Jess and Wolf, Thomas},
+  howpublished = {\\url{https://github.com/huggingface/lerobot}},
+  year         = {2024}
+}"""
+
+KIND_MEANING = {
+    "demo": "full demonstration by the operator on true poses",
+    "intervention": "human-gated: the base policy on corrupted poses, then the operator's recovery (flagged)",
+    "mimicgen": "generated demonstration: source segments moved into a new scene (MimicGen)",
+    "igen": "generated intervention: the policy's own mistake, then a replayed source recovery (flagged)",
+    "igen_no_policy": "generated intervention (ablation): a replayed source mistake, then a replayed recovery",
+}
+
+
+def _table(rows: list[tuple[str, ...]]) -> list[str]:
+    head, *body = rows
+    return [f"| {' | '.join(head)} |", f"|{'---|' * len(head)}", *[f"| {' | '.join(r)} |" for r in body]]
+
+
+def _made_by(meta: dict) -> list[str]:
+    lines = []
+    parts = meta.get("parts")
+    if parts:  # a merge: describe each part
+        lines.append(f"Made by `igen-merge` from {len(parts)} datasets (each part repeated as listed):")
+        lines.append("")
+        rows = [("part", "made by", "mode", "seed", "repeats", "frames", "episodes per kind")]
+        for p in parts:
+            kinds = ", ".join(f"{k} {v}" for k, v in (p.get("episode_kinds") or {}).items())
+            rows.append(
+                (
+                    f"`{p.get('root')}`",
+                    str(p.get("created_by")),
+                    str(p.get("mode")),
+                    str(p.get("seed")),
+                    str(p.get("repeats")),
+                    str(p.get("frames")),
+                    kinds,
+                )
+            )
+        return lines + _table(rows)
+    lines.append(
+        f"Made by `{meta.get('created_by', 'unknown')}`" + (f", mode `{meta['mode']}`" if "mode" in meta else "")
+    )
+    if "seed" in meta:
+        lines[-1] += f", run seed {meta['seed']} (episode i uses a seed derived from it: every episode can be replayed)"
+    lines[-1] += "."
+    if meta.get("source"):
+        lines.append(f"- Source dataset: `{meta['source']}`.")
+    if meta.get("input"):
+        lines.append(f"- Imported from `{meta['input']}` ({meta.get('format')}).")
+    if meta.get("operator"):
+        operator = meta["operator"]
+        who = "the scripted operator (it sees the true poses)" if operator == "scripted" else "a person (teleoperation)"
+        lines.append(f"- Operator: {who}.")
+    if meta.get("policy"):
+        lines.append(f"- Base policy: `{meta['policy']}`.")
+    generation = meta.get("generation")
+    if generation:
+        rate = 100 * float(generation.get("success_rate", 0.0))
+        dropped = ", ".join(f"{k} {v}" for k, v in (generation.get("dropped") or {}).items()) or "none"
+        lines.append(
+            f"- Generation: {generation.get('attempted')} attempts, success rate {rate:.1f}% (dropped: {dropped})."
+        )
+    if meta.get("rejections"):
+        lines.append(f"- Attempts rejected while recording: {meta['rejections']}.")
+    config = meta.get("config") or meta.get("env")
+    if config:
+        lines += [
+            "",
+            "The exact config (draccus, as the command parsed it):",
+            "",
+            "```json",
+            json.dumps(config, indent=2, default=str),
+            "```",
+        ]
+    return lines
+
+
+def _error_model(meta: dict) -> str:
+    config = meta.get("config") or {}
+    env = config.get("env") if isinstance(config, dict) else None
+    env = env or meta.get("env") or {}
+    corruption = env.get("corruption") if isinstance(env, dict) else None
+    if not corruption:
+        return "see the config below"
+    return "`" + json.dumps(corruption, default=str) + "`"
+
+
+def card_fields(root: Path, spec: TaskSpec, info: dict, meta: dict, command: list[str] | None = None) -> dict:
+    """Keyword arguments for LeRobot's card template (``dataset_description``, ``url``, ``paper``, citations)."""
+    kinds = meta.get("episode_kinds") or {}
+    total_eps, total_frames = info.get("total_episodes"), info.get("total_frames")
+    reveal = meta.get("reveal", spec.reveal.value)
+    lines = [
+        f"**{spec.name}**, an [IntervenGen]({PAPER_URL}) dataset made with igen-lerobot: "
+        f"{total_eps} episodes, {total_frames} frames at {info.get('fps', spec.fps)} Hz, "
+        f'robot `{info.get("robot_type", spec.robot_type)}`, instruction: "{spec.instruction}"',
+        "",
+        "## What the data is",
+        "",
+        f"- **Task**: {spec.name}; objects {', '.join(f'`{o}`' for o in spec.objects)}; subtasks "
+        + ", ".join(f"`{s.name}` (relative to `{s.object_name}`)" for s in spec.subtasks)
+        + ".",
+        f"- **Action** ({len(spec.action_names)}): {', '.join(f'`{n}`' for n in spec.action_names)}. Deltas are "
+        "offsets of the controller's goal from the current end-effector pose (robosuite's OSC semantics): "
+        "positions in metres, rotations as a world-frame axis-angle in radians; `gripper` −1 open, +1 close.",
+        f"- **`observation.state`** ({len(spec.state_names)}): {', '.join(f'`{n}`' for n in spec.state_names)} "
+        "(metres, quaternion x, y, z, w).",
+        f"- **`observation.environment_state`** ({len(spec.env_state_names)}): every object's pose **as the robot "
+        "believes it**, then the reveal signals: " + ", ".join(f"`{n}`" for n in spec.env_state_names) + ".",
+        f"- **Observation error**: the observed pose of `{spec.corrupted_object}` is wrong, drawn per episode from "
+        f"{_error_model(meta)}; it is revealed on {' – '.join(spec.reveal_contact or ('nothing',))} contact with "
+        f"reveal mode `{reveal}`.",
+        "- **Episodes per kind**: " + "; ".join(f"{k} {v} ({KIND_MEANING.get(k, k)})" for k, v in kinds.items()) + ".",
+        "",
+        "## Columns beyond the policy's inputs",
+        "",
+        "`complementary_info.*` columns are igen's per-frame facts; `lerobot-train` ignores them. "
+        "**The true object pose is privileged**: it exists for generation and analysis and must never be a "
+        "policy input (a policy that reads it sees through the error the data is about).",
+        "",
+        *_table([("column", "dtype (shape)", "meaning"), *SCHEMA_DOC_ROWS]),
+        "",
+        "## How it was made",
+        "",
+        *_made_by(meta),
+    ]
+    if command:
+        lines += ["", "Pushed with:", "", "```bash", shlex.join(command), "```"]
+    lines += [
+        "",
+        "## Limitations",
+        "",
+        "- Simulation only (MuJoCo physics with robosuite 1.5 models); the real robot differs in dynamics, "
+        "sensing and contact.",
+        "- Where the operator is `scripted`, the interventions come from a rule that sees the true poses, not "
+        "from a person: recoveries are more regular than human ones.",
+        "- Generated episodes replay transformed source segments open loop; only successful attempts are kept, "
+        "so the data says nothing about failure rates (see the generation success rate above).",
+        "",
+        "## License",
+        "",
+        "The data: Apache-2.0, as igen-lerobot. The robot and object models it was simulated with come from "
+        "robosuite (MIT).",
+    ]
+    return {
+        "dataset_description": "\n".join(lines),
+        "url": HOMEPAGE,
+        "paper": PAPER_URL,
+        "citation_bibtex": CITATIONS,
+    }
