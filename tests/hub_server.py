@@ -3,7 +3,8 @@
 It serves the HTTP endpoints that ``huggingface_hub`` (and through it LeRobot's ``push_to_hub``
 and ``LeRobotDataset(repo_id)``) use for dataset repositories: create a repo, branches,
 preupload, commit (NDJSON, regular files), tags, refs, revision info, recursive tree, file
-resolve (HEAD and GET, with ranges), card YAML validation and whoami. Repositories live in
+resolve (HEAD and GET, with ranges), card YAML validation, whoami and the client's agent-harness
+registry. Repositories live in
 memory as commits of whole file snapshots. Tokens authenticate: writes need one, private
 repositories are invisible without one. Any request it does not know is recorded in
 ``unknown`` and answered 500, so a test can assert that the client spoke only this protocol.
@@ -167,6 +168,7 @@ class FakeHub:
             self.requests.append((method, path))
         routes = [
             ("GET", r"^/api/whoami-v2$", self.whoami),
+            ("GET", r"^/api/agent-harnesses$", self.agent_harnesses),
             ("POST", r"^/api/repos/create$", self.create_repo),
             ("POST", r"^/api/validate-yaml$", self.validate_yaml),
             ("POST", rf"^/api/{REPO}/preupload/(?P<rev>[^/]+)$", self.preupload),
@@ -198,6 +200,10 @@ class FakeHub:
             self._error(request, 401, "", "Invalid credentials")
             return
         self._send(request, 200, {"type": "user", "name": user, "orgs": [], "auth": {"accessToken": {"role": "write"}}})
+
+    def agent_harnesses(self, request, match, query, method) -> None:
+        """The client's user-agent registry (best-effort telemetry): an empty one."""
+        self._send(request, 200, {"standardEnvVars": [], "harnesses": {}})
 
     def create_repo(self, request, match, query, method) -> None:
         user = self._user(request)

@@ -69,7 +69,6 @@ def env_for(hub, tmp_path, token=TOKEN, endpoint=None):
         "HF_ENDPOINT": endpoint or hub.url,
         "HF_HUB_OFFLINE": "0",
         "HF_HOME": str(tmp_path / "hf_home"),
-        "HF_HUB_DISABLE_TELEMETRY": "1",
         "MUJOCO_GL": "egl",
     }
     env.pop("HF_TOKEN", None)
