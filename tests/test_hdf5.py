@@ -167,6 +167,12 @@ def test_bad_files_are_refused_with_the_reason_and_nothing_is_written(fake_demos
     write_mimicgen_file(no_datagen, config, episodes[:2], ["demo_0", "demo_1"], drop="datagen_info")
     with h5py.File(tmp_path / "not_robomimic.hdf5", "w") as f:
         f.create_dataset("x", data=np.zeros(3))
+    sheared = tmp_path / "sheared.hdf5"
+    sheared.write_bytes(good.read_bytes())
+    with h5py.File(sheared, "r+") as f:  # demo_1's object poses are no rigid transforms
+        poses = f["data/demo_1/datagen_info/object_poses/block"][()]
+        poses[:, 0, 1] += 0.5
+        f["data/demo_1/datagen_info/object_poses/block"][...] = poses
     cases = [
         ([f"--input={truncated}", FAKE], "not a readable HDF5 file|cannot be read"),
         ([f"--input={garbage}", FAKE], "not a readable HDF5 file"),
@@ -177,6 +183,10 @@ def test_bad_files_are_refused_with_the_reason_and_nothing_is_written(fake_demos
         ([f"--input={good}", FAKE, "--object_names={block: cube}"], r"has no 'cube'.*--object_names"),
         ([f"--input={good}", FAKE, "--subtask_signals=[closed]"], r"no 'closed'.*--subtask_signals"),
         ([f"--input={good}", FAKE, "--format=rlds"], "--format must be one of"),
+        (
+            [f"--input={sheared}", FAKE],
+            r"data/demo_1/datagen_info/object_poses/block holds matrices that are not rigid",
+        ),
     ]
     out = tmp_path / "out"
     for args, message in cases:

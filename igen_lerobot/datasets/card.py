@@ -90,8 +90,11 @@ def _made_by(meta: dict) -> list[str]:
     if "seed" in meta:
         lines[-1] += f", run seed {meta['seed']} (episode i uses a seed derived from it: every episode can be replayed)"
     lines[-1] += "."
+    if meta.get("command"):
+        lines += ["", "```bash", meta["command"], "```", ""]
     if meta.get("source"):
-        lines.append(f"- Source dataset: `{meta['source']}`.")
+        counts = ", ".join(f"{k} {v}" for k, v in (meta.get("source_kinds") or {}).items())
+        lines.append(f"- Source dataset: `{meta['source']}`" + (f" ({counts} episodes)." if counts else "."))
     if meta.get("input"):
         lines.append(f"- Imported from `{meta['input']}` ({meta.get('format')}).")
     if meta.get("operator"):

@@ -22,7 +22,7 @@ from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_merge import MergeConfig
 from igen_lerobot.datasets.reader import check_features, dataset_spec, read_igen_meta
 from igen_lerobot.datasets.schema import RL_COLUMNS, SCHEMA_VERSION
-from igen_lerobot.datasets.writer import IGEN_META_FILE, write_lerobot_dataset
+from igen_lerobot.datasets.writer import IGEN_META_FILE, running_command, write_lerobot_dataset
 
 logger = logging.getLogger(__name__)
 
@@ -111,6 +111,7 @@ def merge_datasets(
         "reveal": spec.reveal.value,
         "episode_kinds": kinds,
         "created_by": "merge",
+        "command": running_command(),
         "parts": [
             {
                 "root": str(r),

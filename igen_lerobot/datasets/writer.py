@@ -10,7 +10,9 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
+import shlex
 import shutil
+import sys
 import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -123,6 +125,11 @@ class DatasetBuilder:
         shutil.rmtree(self.work_dir)
 
 
+def running_command() -> str:
+    """The command line of this process, as a user would type it (recorded with every dataset)."""
+    return shlex.join([Path(sys.argv[0]).name, *sys.argv[1:]])
+
+
 def write_lerobot_dataset(
     build_dir: Path,
     repo_id: str,
@@ -161,7 +168,13 @@ def write_lerobot_dataset(
             frames += episode.length
             kinds[episode.kind] = kinds.get(episode.kind, 0) + 1
     dataset.finalize()
-    meta = {"schema_version": SCHEMA_VERSION, "task": spec.name, "reveal": spec.reveal.value, **metadata}
+    meta = {
+        "schema_version": SCHEMA_VERSION,
+        "task": spec.name,
+        "reveal": spec.reveal.value,
+        "command": running_command(),
+        **metadata,
+    }
     meta["episode_kinds"] = kinds
     (build_dir / IGEN_META_FILE).write_text(json.dumps(meta, indent=2, default=str))
     return frames, kinds

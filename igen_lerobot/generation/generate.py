@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from collections import Counter
 from pathlib import Path
 
 import draccus
@@ -145,6 +146,8 @@ def generate(cfg: GenerateConfig) -> None:
             "mode": mode.value,
             "seed": cfg.seed,
             "source": str(source_root),
+            "source_episodes": len(episodes),
+            "source_kinds": dict(Counter(ep.kind for ep in episodes)),
             "policy": cfg.policy.path or "scripted",
             "config": draccus.encode(cfg),
             "generation": {
