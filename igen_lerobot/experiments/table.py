@@ -29,7 +29,7 @@ from pathlib import Path
 
 from igen_lerobot.core.exceptions import IgenError
 from igen_lerobot.experiments.config_table import TableConfig
-from igen_lerobot.training.lerobot_train import clear_interrupted_run, train_command
+from igen_lerobot.training.lerobot_train import final_checkpoint, run_command, train_command
 
 logger = logging.getLogger(__name__)
 
@@ -74,8 +74,12 @@ class TableRun:
     def data(self, name: str) -> Path:
         return self.out / "data" / name
 
-    def run(self, name: str, command: list[str], done: Path) -> None:
-        """Run ``command`` unless ``done`` exists; its output goes to ``logs/<name>.log``."""
+    def run(self, name: str, command: list[str], done: Path, execute: list[str] | None = None) -> None:
+        """Run ``command`` unless ``done`` exists; its output is appended to ``logs/<name>.log``.
+
+        ``execute``, when given, is what actually runs (a training resumed from its checkpoint),
+        while ``command`` is what the table records: the command that makes the step from scratch.
+        """
         shown = shlex.join([Path(command[0]).name, *command[1:]])
         self.commands.append({"step": name, "command": shown})
         if done.exists():
@@ -83,15 +87,17 @@ class TableRun:
             return
         log = self.out / "logs" / f"{name}.log"
         log.parent.mkdir(parents=True, exist_ok=True)
-        logger.info("%s: %s", name, shown)
+        command = execute or command
+        logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
         start = time.perf_counter()
         if self.cfg.in_process:
             code = _run_in_process(command, log)
         else:
-            with open(log, "w") as sink:
+            with open(log, "a") as sink:
                 code = subprocess.run(command, stdout=sink, stderr=subprocess.STDOUT, env=os.environ.copy()).returncode
         if code == 0 and done.exists():
-            self.timings[name] = time.perf_counter() - start
+            # a resumed step adds this leg to what earlier legs recorded
+            self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
             self.timings_file.parent.mkdir(parents=True, exist_ok=True)
             self.timings_file.write_text(json.dumps(self.timings, indent=2))
         if code != 0 or not done.exists():
@@ -112,7 +118,7 @@ def _run_in_process(command: list[str], log: Path) -> int:
     saved = sys.argv
     sys.argv = [tool, *command[1:]]
     try:
-        with open(log, "w") as sink, contextlib.redirect_stdout(sink):
+        with open(log, "a") as sink, contextlib.redirect_stdout(sink):
             main()
         return 0
     except SystemExit as error:
@@ -255,9 +261,10 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
 def train(run: TableRun, variant: str, dataset: Path) -> Path:
     """``lerobot-train`` on a variant's dataset (same config for all); returns the last checkpoint."""
     out = run.out / "train" / variant
-    done = out / "checkpoints" / "last" / "pretrained_model" / "config.json"
-    clear_interrupted_run(out)
-    run.run(f"train_{variant}", train_command(run.cfg.train, dataset, f"local/{dataset.name}", out), done)
+    done = final_checkpoint(out, run.cfg.train.steps) / "config.json"
+    command = train_command(run.cfg.train, dataset, f"local/{dataset.name}", out)
+    execute = None if done.exists() else run_command(run.cfg.train, dataset, f"local/{dataset.name}", out)
+    run.run(f"train_{variant}", command, done, execute)
     return done.parent
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import subprocess
@@ -23,13 +24,34 @@ def checkpoint_path(output_dir: Path) -> Path:
     return Path(output_dir) / "checkpoints" / "last" / "pretrained_model"
 
 
+def final_checkpoint(output_dir: Path, steps: int) -> Path:
+    """The ``pretrained_model/`` folder a run of ``steps`` steps leaves at its end (named as LeRobot names it)."""
+    from lerobot.common.train_utils import get_step_checkpoint_dir
+
+    return get_step_checkpoint_dir(Path(output_dir), steps, steps) / "pretrained_model"
+
+
+def last_saved_step(output_dir: Path) -> int | None:
+    """The step of a run's last checkpoint (None: no checkpoint yet)."""
+    state = Path(output_dir) / "checkpoints" / "last" / "training_state" / "training_step.json"
+    if not (checkpoint_path(output_dir) / "config.json").exists() or not state.exists():
+        return None
+    return int(json.loads(state.read_text())["step"])
+
+
+def is_finished(output_dir: Path, steps: int) -> bool:
+    """Whether the run reached ``steps`` (a run stopped after an intermediate checkpoint has not)."""
+    saved = last_saved_step(output_dir)
+    return saved is not None and saved >= steps
+
+
 def clear_interrupted_run(output_dir: Path) -> None:
-    """Remove a run that stopped before its last checkpoint: lerobot-train refuses an existing output_dir."""
+    """Remove a run that stopped before its first checkpoint: lerobot-train refuses an existing output_dir."""
     output_dir = Path(output_dir)
-    if output_dir.exists() and not (checkpoint_path(output_dir) / "config.json").exists():
+    if output_dir.exists() and last_saved_step(output_dir) is None:
         import shutil
 
-        logger.info("removing the interrupted training run %s", output_dir)
+        logger.info("removing the interrupted training run %s (no checkpoint to resume from)", output_dir)
         shutil.rmtree(output_dir)
 
 
@@ -53,23 +75,48 @@ def train_command(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir
     ]
 
 
+def resume_command(cfg: TrainConfig, output_dir: Path) -> list[str]:
+    """LeRobot's own resume from the run's last checkpoint (optimizer, RNG and step restored)."""
+    config = checkpoint_path(output_dir) / "train_config.json"
+    return [
+        str(Path(sys.executable).parent / "lerobot-train"),
+        "--resume=true",
+        f"--config_path={config}",
+        f"--steps={cfg.steps}",
+        f"--save_freq={cfg.save_freq or cfg.steps}",
+    ]
+
+
+def run_command(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir: Path) -> list[str]:
+    """The command that brings the run at ``output_dir`` to ``cfg.steps``: resumed if it has a checkpoint.
+
+    Hours of CPU training are not thrown away when a session ends: a run with a checkpoint short of
+    its steps continues from it; one without a checkpoint starts again.
+    """
+    clear_interrupted_run(output_dir)
+    saved = last_saved_step(output_dir)
+    if saved is None:
+        return train_command(cfg, dataset_root, repo_id, output_dir)
+    logger.info("resuming the training run %s from step %d of %d", output_dir, saved, cfg.steps)
+    return resume_command(cfg, output_dir)
+
+
 def lerobot_train(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir: Path) -> Path:
     """Run ``lerobot-train`` on a local dataset; returns the last checkpoint's ``pretrained_model/``."""
     output_dir = Path(output_dir)
     done = checkpoint_path(output_dir)
-    if (done / "config.json").exists():
+    if is_finished(output_dir, cfg.steps):
         logger.info("training already done: %s", done)
         return done
-    clear_interrupted_run(output_dir)
-    command = train_command(cfg, dataset_root, repo_id, output_dir)
+    command = run_command(cfg, dataset_root, repo_id, output_dir)
     logger.info("training: %s", " ".join(command))
     log = output_dir.with_name(output_dir.name + ".log")
     log.parent.mkdir(parents=True, exist_ok=True)
-    with open(log, "w") as out:
+    with open(log, "a") as out:
         result = subprocess.run(command, stdout=out, stderr=subprocess.STDOUT, env={**os.environ}, check=False)
     if result.returncode != 0:
         tail = log.read_text()[-2000:]
         raise TrainingFailedError(f"lerobot-train failed (exit {result.returncode}); log {log}:\n{tail}")
-    if not (done / "config.json").exists():
+    if not is_finished(output_dir, cfg.steps):
         raise TrainingFailedError(f"lerobot-train finished without a checkpoint at {done}; log {log}")
     return done

@@ -1,0 +1,39 @@
+"""An interrupted ``lerobot-train`` run continues from its last checkpoint instead of starting again."""
+
+from __future__ import annotations
+
+import json
+
+from igen_lerobot.training.config_train import TrainConfig
+from igen_lerobot.training.lerobot_train import final_checkpoint, is_finished, last_saved_step, lerobot_train
+
+
+def _step(checkpoint_dir):
+    return json.loads((checkpoint_dir.parent / "training_state" / "training_step.json").read_text())["step"]
+
+
+def test_a_run_stopped_after_a_checkpoint_resumes_from_it(source_demos, tmp_path):
+    out = tmp_path / "bc_rnn"
+    # a run of 4 steps that stopped after its step-2 checkpoint looks like a finished 2-step run on disk
+    short = TrainConfig(policy_type="bc_rnn", steps=2, batch_size=8, num_workers=0, save_freq=2)
+    lerobot_train(short, source_demos, "local/block_grasp_demos", out)
+    full = TrainConfig(policy_type="bc_rnn", steps=4, batch_size=8, num_workers=0, save_freq=2)
+    assert last_saved_step(out) == 2 and not is_finished(out, full.steps)
+    first_weights = (out / "checkpoints" / "000002" / "pretrained_model" / "model.safetensors").read_bytes()
+
+    done = lerobot_train(full, source_demos, "local/block_grasp_demos", out)
+
+    assert is_finished(out, full.steps) and _step(done) == 4
+    assert final_checkpoint(out, full.steps) == out / "checkpoints" / "000004" / "pretrained_model"
+    # resumed, not restarted: the step-2 checkpoint is the one the first leg wrote, and LeRobot says so
+    assert (out / "checkpoints" / "000002" / "pretrained_model" / "model.safetensors").read_bytes() == first_weights
+    log = (tmp_path / "bc_rnn.log").read_text()
+    assert "'resume': True" in log and "Resuming data order" in log
+
+
+def test_a_run_without_a_checkpoint_starts_again(source_demos, tmp_path):
+    out = tmp_path / "bc_rnn"
+    (out / "checkpoints").mkdir(parents=True)  # killed before its first save
+    cfg = TrainConfig(policy_type="bc_rnn", steps=2, batch_size=8, num_workers=0)
+    done = lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
+    assert _step(done) == 2 and is_finished(out, 2)
