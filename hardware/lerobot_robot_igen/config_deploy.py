@@ -19,7 +19,9 @@ from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.evaluation.config_eval import EVAL_SEED
 from igen_lerobot.training.policy_source import PolicySourceConfig
 from igen_lerobot.viz.rerun_log import RerunConfig
+from lerobot_env_igen.d415 import D415Noise
 from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
+from lerobot_robot_igen.pose_gate import PoseGateSettings
 from lerobot_robot_igen.safety import SafetyLimits
 
 
@@ -36,7 +38,7 @@ class RenderedPerceptionConfig(PerceptionConfig):
     distance: float = 0.85  # [m] from the centre of the cube region
     azimuth_deg: float = 180.0
     elevation_deg: float = -55.0
-    depth_noise_m: float = 0.001
+    noise: D415Noise = field(default_factory=D415Noise)  # the D415 sensor model (--perception.noise.subpixel=...)
 
 
 @PerceptionConfig.register_subclass("truth")
@@ -81,6 +83,7 @@ class DeployConfig:
     max_steps: int = 200
     contact_force_threshold: float = 2.0  # [N]
     max_pose_age: float = 0.5  # [s]
+    pose_gate: PoseGateSettings = field(default_factory=PoseGateSettings)  # confidence and jump checks
     realtime: bool | None = None  # None: real arms pace to the wall clock, rehearsals run as fast as they can
     safety: SafetyLimits = field(default_factory=SafetyLimits)
     world_from_base: tuple[float, float, float] = REAL_WORLD_FROM_BASE_XYZ  # real arms; the sim knows its own

@@ -62,7 +62,7 @@ def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
     if isinstance(p, TruthPerceptionConfig):
         return pose_source.SimTruthPose(driver)
     if isinstance(p, RenderedPerceptionConfig):
-        return pose_source.RenderedICPPose(driver, p.distance, p.azimuth_deg, p.elevation_deg, p.depth_noise_m)
+        return pose_source.RenderedICPPose(driver, p.distance, p.azimuth_deg, p.elevation_deg, p.noise)
     if isinstance(p, RealSensePerceptionConfig):
         from lerobot_robot_igen.perception.camera_model import load_extrinsics
         from lerobot_robot_igen.realsense import RealSenseConfig, RealSenseRGBD
@@ -115,6 +115,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         contact_force_threshold=cfg.contact_force_threshold,
         max_pose_age=cfg.max_pose_age,
         realtime=bool(cfg.realtime),
+        pose_gate=cfg.pose_gate,
     )
     outcomes: list[EpisodeOutcome] = []
     step_times: list[float] = []
@@ -203,6 +204,7 @@ def deploy_logger(viz: EpisodeLogger, arm: SafeArm):
             cloud=cloud,
             contact=rec.contact,
             timing_ms={k: 1000 * v for k, v in rec.seconds.items()},
+            pose_rejection=rec.pose_rejection,
         )
         if perceived is not None:
             state["previous"] = perceived

@@ -3,8 +3,11 @@
 One loop for the real arm and for its rehearsal in simulation. Each period:
 
 1. read the arm (task frame) — a measured pose outside the workspace stops it;
-2. read the cube pose; if perception fails, keep the last estimate for at most
-   ``max_pose_age`` seconds, then stop (stale perception);
+2. read the cube pose; the estimator may reject the frame, and the loop's
+   :class:`~lerobot_robot_igen.pose_gate.PoseGate` rejects low-confidence estimates and jumps
+   the cube could not have made; a rejected frame is bridged by the last accepted estimate for
+   at most ``max_pose_age`` seconds, then the arm stops (stale perception). Every rejection is
+   recorded with its reason (JSON report, Rerun);
 3. contact = external force above ``contact_force_threshold``; the first contact reveals the pose;
 4. build the observation exactly as in training and ask the policy for an action;
 5. send the target through :class:`~lerobot_robot_igen.arm.SafeArm` (limits, watchdog);
@@ -33,6 +36,7 @@ from lerobot_env_igen.block_grasp.spec import SPEC as BLOCK_GRASP_SPEC
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.driver import ArmState, DriverError
 from lerobot_robot_igen.perception.cube_pose import PerceptionError
+from lerobot_robot_igen.pose_gate import PoseGate, PoseGateSettings
 from lerobot_robot_igen.pose_source import PoseReading, PoseSource
 from lerobot_robot_igen.safety import SafetyViolationError
 
@@ -52,6 +56,7 @@ class LoopSettings:
     contact_force_threshold: float = 2.0  # [N] external force that counts as touching the cube
     max_pose_age: float = 0.5  # [s] act on a previous cube estimate for at most this long
     realtime: bool = True  # pace to the wall clock (real arms); False: as fast as the sim steps
+    pose_gate: PoseGateSettings = field(default_factory=PoseGateSettings)
 
 
 @dataclass
@@ -70,6 +75,7 @@ class StepRecord:
     revealed: bool
     pose_fresh: bool
     reading: PoseReading | None
+    pose_rejection: str | None  # why this period's estimate was not used (None: used, or none needed)
     seconds: dict[str, float]  # perception, policy, command, step (compute time), period (tick to tick)
 
 
@@ -82,11 +88,17 @@ class EpisodeOutcome:
     fault: str | None = None  # why the arm was stopped, if it was
     revealed_at: int | None = None
     timing: dict[str, dict[str, float]] = field(default_factory=dict)
-    perception_failures: int = 0
+    perception_failures: int = 0  # frames the estimator rejected
+    low_confidence: int = 0  # estimates the loop did not trust
+    rejected_jumps: int = 0  # estimates further than the cube could have moved
+    pose_rejections: list[dict] = field(default_factory=list)  # {step, kind, reason}, the first MAX_LOGGED
     clamped_targets: int = 0
 
     def to_json(self) -> dict:
         return asdict(self)
+
+
+MAX_LOGGED_REJECTIONS = 200
 
 
 def timing_stats(samples: list[float]) -> dict[str, float]:
@@ -126,6 +138,8 @@ def run_episode(
     outcome = EpisodeOutcome(success=False, steps=0)
     T_world_cube: np.ndarray | None = None
     pose_time = -np.inf  # loop time of the last good estimate
+    gate = PoseGate(settings.pose_gate)
+    gripper_closed = False
     last_tick = None
     try:
         for step in range(settings.max_steps):
@@ -138,20 +152,25 @@ def run_episode(
             state, T_world_eef = arm.read()
 
             start = time.perf_counter()
-            reading, fresh = None, False
+            reading, fresh, rejection = None, False, None
             try:
+                poses.may_be_lifted = gripper_closed
                 reading = poses.read()
-                T_world_cube = arm.T_world_base @ reading.T_base_cube
-                pose_time, fresh = loop_time, True
+                candidate = arm.T_world_base @ reading.T_base_cube
+                rejection = gate.judge(reading, candidate, loop_time)
+                if rejection is None:
+                    T_world_cube, pose_time, fresh = candidate, loop_time, True
             except PerceptionError as err:
-                outcome.perception_failures += 1
+                rejection = ("estimator", str(err))
+            if rejection is not None:
+                _count_rejection(outcome, step, *rejection)
                 if T_world_cube is None or loop_time - pose_time > max_stale:
                     age = "no estimate yet"
                     if T_world_cube is not None:
                         age = f"last good one {loop_time - pose_time:.2f} s old"
                     raise StalePerceptionError(
-                        f"no cube pose ({err}); {age}, more than max_pose_age={max_stale} s"
-                    ) from err
+                        f"no cube pose ({rejection[1]}); {age}, more than max_pose_age={max_stale} s"
+                    )
             times["perception"].append(time.perf_counter() - start)
 
             felt = state.external_force > settings.contact_force_threshold
@@ -166,7 +185,8 @@ def run_episode(
             times["policy"].append(time.perf_counter() - start)
 
             start = time.perf_counter()
-            target = arm.command(T_world_eef, action[:3], close_gripper=bool(action[3] > 0.0), period=period)
+            gripper_closed = bool(action[3] > 0.0)
+            target = arm.command(T_world_eef, action[:3], close_gripper=gripper_closed, period=period)
             times["command"].append(time.perf_counter() - start)
             times["step"].append(time.perf_counter() - tick)
             if on_step is not None:
@@ -184,6 +204,7 @@ def run_episode(
                         revealed=belief.revealed,
                         pose_fresh=fresh,
                         reading=reading,
+                        pose_rejection=None if rejection is None else f"{rejection[0]}: {rejection[1]}",
                         seconds={k: v[-1] for k, v in times.items() if v},
                     )
                 )
@@ -204,3 +225,15 @@ def run_episode(
         outcome.timing = {name: timing_stats(values) for name, values in times.items()}
         outcome.clamped_targets = arm.clamped_targets
     return outcome
+
+
+def _count_rejection(outcome: EpisodeOutcome, step: int, kind: str, reason: str) -> None:
+    if kind == "estimator":
+        outcome.perception_failures += 1
+    elif kind == "low_confidence":
+        outcome.low_confidence += 1
+    else:
+        outcome.rejected_jumps += 1
+    if len(outcome.pose_rejections) < MAX_LOGGED_REJECTIONS:
+        outcome.pose_rejections.append({"step": step, "kind": kind, "reason": reason})
+    logger.info("step %d: cube estimate not used (%s): %s", step, kind, reason)

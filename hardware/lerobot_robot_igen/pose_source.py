@@ -32,6 +32,7 @@ class PoseSource(abc.ABC):
     """A cube pose estimator the loop polls once per control period."""
 
     last_frame: tuple[np.ndarray, np.ndarray] | None = None  # (color, depth) of the last read, even a failed one
+    may_be_lifted: bool = False  # the loop sets it while the gripper is closed: the cube may be off the table
 
     @abc.abstractmethod
     def read(self) -> PoseReading:
@@ -52,10 +53,10 @@ class SimTruthPose(PoseSource):
 
 
 class RenderedICPPose(PoseSource):
-    """A D415-like camera rendered from the simulated scene, through the real ICP estimator.
+    """A D415 rendered from the simulated scene, through the real ICP estimator.
 
     The camera stands on a tripod in front of the table looking down at the cube region, as on
-    the real setup; depth gets the D415's noise and millimetre quantisation.
+    the real setup; each frame goes through the D415 sensor model (:mod:`lerobot_env_igen.d415`).
     """
 
     def __init__(
@@ -64,7 +65,7 @@ class RenderedICPPose(PoseSource):
         distance: float = 0.85,
         azimuth_deg: float = 180.0,
         elevation_deg: float = -55.0,
-        depth_noise_m: float = 0.001,
+        noise=None,
         seed: int = 0,
         config: CubePoseConfig | None = None,
     ) -> None:
@@ -80,16 +81,19 @@ class RenderedICPPose(PoseSource):
         width, height = self.camera.width, self.camera.height
         intrinsics = Intrinsics.from_vertical_fov(width, height, self.camera.fovy_deg)
         self.estimator = CubePoseEstimator(intrinsics, T_base_camera, config)
-        self.depth_noise_m = depth_noise_m
+        from lerobot_env_igen.d415 import D415Noise
+
+        self.noise = noise if noise is not None else D415Noise()
+        self.focal_px = intrinsics.fx
         self.rng = np.random.default_rng(seed)
 
     def read(self) -> PoseReading:
+        from lerobot_env_igen.d415 import d415_frame
+
         rgb, depth, _ = self.camera.render()
-        if self.depth_noise_m > 0:
-            depth = depth + self.rng.normal(0.0, self.depth_noise_m, size=depth.shape).astype(np.float32)
-        depth = (np.round(depth * 1000.0) / 1000.0).astype(np.float32)
+        rgb, depth = d415_frame(rgb, depth, self.rng, self.focal_px, self.noise)
         self.last_frame = (rgb, depth)
-        estimate = self.estimator.estimate(rgb, depth)
+        estimate = self.estimator.estimate(rgb, depth, self.may_be_lifted)
         return PoseReading(T_base_cube=estimate.T_base_cube, estimate=estimate, color=rgb, depth=depth)
 
     def close(self) -> None:
@@ -108,7 +112,7 @@ class RealSenseICPPose(PoseSource):
     def read(self) -> PoseReading:
         color, depth, _ = self.camera.read()
         self.last_frame = (color, depth)
-        estimate = self.estimator.estimate(color, depth)
+        estimate = self.estimator.estimate(color, depth, self.may_be_lifted)
         return PoseReading(T_base_cube=estimate.T_base_cube, estimate=estimate, color=color, depth=depth)
 
     def close(self) -> None:

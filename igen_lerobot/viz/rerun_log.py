@@ -221,6 +221,7 @@ class EpisodeLogger:
         cloud: np.ndarray | None = None,
         contact: bool = False,
         timing_ms: dict[str, float] | None = None,
+        pose_rejection: str | None = None,
     ) -> None:
         """One deployment period (task frame).
 
@@ -247,6 +248,9 @@ class EpisodeLogger:
         if cloud is not None and len(cloud):
             stream.log("deploy/cube/cloud", rr.Points3D(cloud, colors=[(255, 0, 0)], radii=0.001))
         stream.log("deploy/contact", rr.Scalars(float(contact)))
+        stream.log("deploy/cube/estimate_used", rr.Scalars(float(pose_rejection is None)))
+        if pose_rejection is not None:
+            stream.log("deploy/perception/rejections", rr.TextLog(pose_rejection, level="WARN"))
         for name, value in (timing_ms or {}).items():
             stream.log(f"deploy/timing_ms/{name}", rr.Scalars(value))
 

@@ -7,10 +7,44 @@ mounted D415 would be; its pose is read back from MuJoCo so the extrinsics are e
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 
 D415_VERTICAL_FOV_DEG = 42.6  # color stream at 640x480 (fy ~ 615 px)
+
+
+@dataclass(frozen=True)
+class Prop:
+    """A visual-only object added to a rendered frame (an occluder, a distractor): seen, never simulated."""
+
+    shape: str  # "box" or "cylinder"
+    size: tuple[float, float, float]  # MuJoCo geom size (half extents; cylinder: radius, half height, -)
+    pos: tuple[float, float, float]
+    rotation: tuple[float, ...]  # row-major 3x3
+    rgba: tuple[float, float, float, float]
+
+    def add_to(self, scene: mujoco.MjvScene) -> None:
+        if scene.ngeom >= scene.maxgeom:
+            raise RuntimeError("the render scene has no room for another prop (raise maxgeom)")
+        geom = scene.geoms[scene.ngeom]
+        kind = mujoco.mjtGeom.mjGEOM_BOX if self.shape == "box" else mujoco.mjtGeom.mjGEOM_CYLINDER
+        mujoco.mjv_initGeom(
+            geom,
+            kind,
+            np.asarray(self.size, float),
+            np.asarray(self.pos, float),
+            np.asarray(self.rotation, float),
+            np.asarray(self.rgba, np.float32),
+        )
+        geom.segid = scene.ngeom
+        geom.objid = PROP_OBJID
+        scene.ngeom += 1
+
+
+PROP_OBJID = 1_000_000  # segmentation id of props (never a model object id)
 
 
 class RGBDCamera:
@@ -32,6 +66,7 @@ class RGBDCamera:
         self._color = mujoco.Renderer(model, height=height, width=width)
         self._depth = mujoco.Renderer(model, height=height, width=width)
         self._depth.enable_depth_rendering()
+        self._segmentation: mujoco.Renderer | None = None
         self.camera = mujoco.MjvCamera()
         self.camera.type = mujoco.mjtCamera.mjCAMERA_FREE
         self.option = mujoco.MjvOption()
@@ -50,25 +85,50 @@ class RGBDCamera:
         f = (self.height / 2) / np.tan(np.deg2rad(self.fovy_deg) / 2)
         return self.width, self.height, f, f, self.width / 2 - 0.5, self.height / 2 - 0.5
 
-    def render(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Color, depth and ``T_world_camera`` for the current state of ``data``."""
-        self._color.update_scene(self.data, camera=self.camera, scene_option=self.option)
+    def _update(self, renderer: mujoco.Renderer, props: Sequence[Prop]) -> None:
+        renderer.update_scene(self.data, camera=self.camera, scene_option=self.option)
+        for prop in props:
+            prop.add_to(renderer.scene)
+
+    def segmentation(self, props: Sequence[Prop] = ()) -> np.ndarray:
+        """``(H, W, 2)`` int32 (object id, object type) per pixel; props have id ``PROP_OBJID``."""
+        if self._segmentation is None:
+            self._segmentation = mujoco.Renderer(self.model, height=self.height, width=self.width)
+            self._segmentation.enable_segmentation_rendering()
+        self._update(self._segmentation, props)
+        return self._segmentation.render()
+
+    def render(self, props: Sequence[Prop] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Color, depth and ``T_world_camera`` for the current state of ``data`` (plus ``props``)."""
+        self._update(self._color, props)
         rgb = self._color.render()
-        # a mono render is taken from the midpoint of MuJoCo's two (stereo) eyes, ipd apart
-        eyes = self._color.scene.camera
+        T = self._pose(self._color.scene)
+        self._update(self._depth, props)
+        depth = self._depth.render().astype(np.float32)
+        return rgb, depth, T
+
+    @staticmethod
+    def _pose(scene: mujoco.MjvScene) -> np.ndarray:
+        """``T_world_camera`` (OpenCV axes) of an updated scene: the midpoint of MuJoCo's two (stereo) eyes."""
+        eyes = scene.camera
         forward = np.asarray(eyes[0].forward, dtype=float)
         up = np.asarray(eyes[0].up, dtype=float)
         right = np.cross(forward, up)
         T = np.eye(4)
         T[:3, :3] = np.stack([right, -up, forward], axis=1)  # OpenCV: x right, y down, z forward
         T[:3, 3] = (np.asarray(eyes[0].pos) + np.asarray(eyes[1].pos)) / 2
-        self._depth.update_scene(self.data, camera=self.camera, scene_option=self.option)
-        depth = self._depth.render().astype(np.float32)
-        return rgb, depth, T
+        return T
+
+    def pose(self) -> np.ndarray:
+        """``T_world_camera`` for the current look-at, without rendering."""
+        self._update(self._color, ())
+        return self._pose(self._color.scene)
 
     def close(self) -> None:
         self._color.close()
         self._depth.close()
+        if self._segmentation is not None:
+            self._segmentation.close()
 
 
 def random_cube_view(

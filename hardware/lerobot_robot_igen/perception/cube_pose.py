@@ -11,8 +11,13 @@ Pipeline (robot base frame throughout):
 4. clustering (DBSCAN): the largest cluster is the cube, others (red distractors) are dropped;
 5. initial pose: the cube rests on (or hovers above) the table, so its z axis is the plane
    normal; the yaw comes from the minimum-area rectangle of the points seen from above;
-6. point-to-plane ICP of the observed points onto a surface model of the cube;
-7. a gate on fitness and RMSE, which rejects bad fits with the reason;
+6. point-to-plane ICP of the observed points onto a surface model of the cube, from several
+   starts when the cube is partly hidden: the visible part's rectangle is shorter than the cube,
+   and the cube may extend past either of its sides;
+7. a gate on fitness and RMSE, then the physical checks of :mod:`.consistency` (free space,
+   visibility, support, explanation) on every fit; of the fits that pass, the best is kept, and
+   if two that pass disagree by more than ``ambiguity_distance`` the frame is rejected as ambiguous:
+   a wrong pose is worse than no pose;
 8. symmetry: a cube looks the same under 24 rotations; the reported pose is the one whose z axis
    is closest to the base's +z and whose yaw is in [-45, 45) degrees, so consecutive estimates and
    ground truth compare without spurious 90-degree jumps.
@@ -21,13 +26,14 @@ Pipeline (robot base frame throughout):
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 
 from igen_lerobot.core.exceptions import IgenError
 from lerobot_robot_igen.perception.camera_model import Intrinsics
+from lerobot_robot_igen.perception.consistency import Consistency, ConsistencyChecker, ConsistencyConfig
 
 
 class PerceptionError(IgenError, RuntimeError):
@@ -39,7 +45,11 @@ class CubeNotVisibleError(PerceptionError):
 
 
 class PoseRejectedError(PerceptionError):
-    """ICP converged to a fit that fails the fitness/RMSE gate."""
+    """No fit passes the gates: fitness/RMSE, then the physical consistency checks."""
+
+
+class AmbiguousPoseError(PoseRejectedError):
+    """Two different poses explain the frame equally well (too much of the cube is hidden)."""
 
 
 @dataclass(frozen=True)
@@ -63,6 +73,12 @@ class CubePoseConfig:
     min_fitness: float = 0.85  # share of observed points within icp_max_distance of the model
     max_rmse: float = 0.004  # [m] inlier RMSE
     model_points_per_face: int = 400
+    voxel_size: float = 0.003  # [m] red points are thinned to one per voxel before clustering and ICP
+    # None: fitness/RMSE gate only, one start (the estimator before the consistency checks)
+    consistency: ConsistencyConfig | None = field(default_factory=ConsistencyConfig)
+    truncation: float = 0.006  # [m] a visible side shorter than the cube by this: the cube extends past it
+    ambiguity_distance: float = 0.015  # [m] two passing fits further apart than this: ambiguous, rejected
+    same_fit: float = 0.004  # [m] passing fits closer than this are the same fit
 
 
 @dataclass(frozen=True)
@@ -75,10 +91,20 @@ class CubePoseEstimate:
     num_points: int
     seconds: float
     points: np.ndarray | None = None  # (N, 3) the segmented cube points in the base frame (for logging)
+    consistency: Consistency | None = None
+    hypotheses: int = 1  # fits tried
 
     @property
     def position(self) -> np.ndarray:
         return self.T_base_cube[:3, 3]
+
+    @property
+    def confidence(self) -> float:
+        """1 for a fit every check agrees with; lower as points go unexplained or the camera sees through it."""
+        c = self.consistency
+        if c is None:
+            return float(self.fitness)
+        return float(c.explained * (1.0 - c.free_space_violation) * (1.0 - c.hidden_face_share))
 
     @property
     def yaw(self) -> float:
@@ -151,6 +177,11 @@ class CubePoseEstimator:
         self.model.normals = o3d.utility.Vector3dVector(normals)
         self._kernel = np.ones((2 * self.config.erode_px + 1,) * 2, np.uint8) if self.config.erode_px else None
         self._rng = np.random.default_rng(0)
+        self.checker = (
+            ConsistencyChecker(intrinsics, self.T_base_camera, self.config.cube_size, self.config.consistency)
+            if self.config.consistency is not None
+            else None
+        )
 
     # ------------------------------------------------------------------ stages
     def red_mask(self, color_rgb: np.ndarray) -> np.ndarray:
@@ -196,8 +227,12 @@ class CubePoseEstimator:
             raise PerceptionError(f"no dominant table plane ({len(inliers)} of {len(points)} sampled points)")
         return normal, float(d)
 
-    def _initial_pose(self, points: np.ndarray, normal: np.ndarray) -> np.ndarray:
-        """Cube z along the table normal; yaw and centre from the min-area rectangle of the points."""
+    def _initial_poses(self, points: np.ndarray, normal: np.ndarray) -> list[np.ndarray]:
+        """Starts for ICP: cube z along the table normal, yaw and centre from the min-area rectangle.
+
+        Where the rectangle is shorter than the cube along a side (part of the cube hidden), the
+        cube also starts flush with either end of that side.
+        """
         z = normal
         x_ref = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
         x = x_ref - (x_ref @ z) * z
@@ -205,17 +240,32 @@ class CubePoseEstimator:
         y = np.cross(z, x)
         plane_frame = np.stack([x, y, z], axis=1)
         local = points @ plane_frame
-        (cu, cv), _, angle = cv2.minAreaRect(local[:, :2].astype(np.float32))
+        (cu, cv), (w, h), angle = cv2.minAreaRect(local[:, :2].astype(np.float32))
         top = np.percentile(local[:, 2], 95)
         R = plane_frame @ _rot_z(np.deg2rad(angle))
-        centre = plane_frame @ np.array([cu, cv, top - self.config.cube_size / 2])
-        T = np.eye(4)
-        T[:3, :3], T[:3, 3] = R, centre
-        return T
+        size = self.config.cube_size
+        centre = plane_frame @ np.array([cu, cv, top - size / 2])
+        shifts = [[0.0]]
+        if self.config.consistency is not None:
+            shifts = [
+                [0.0, -(size - extent) / 2, (size - extent) / 2] if extent < size - self.config.truncation else [0.0]
+                for extent in (w, h)
+            ]
+        starts = []
+        for dx in shifts[0]:
+            for dy in shifts[1 % len(shifts)]:
+                T = np.eye(4)
+                T[:3, :3], T[:3, 3] = R, centre + R[:, 0] * dx + R[:, 1] * dy
+                starts.append(T)
+        return starts
 
     # ------------------------------------------------------------------ the whole estimate
-    def estimate(self, color_rgb: np.ndarray, depth_m: np.ndarray) -> CubePoseEstimate:
-        """One frame to one pose, or a :class:`PerceptionError` saying why not."""
+    def estimate(self, color_rgb: np.ndarray, depth_m: np.ndarray, may_be_lifted: bool = False) -> CubePoseEstimate:
+        """One frame to one pose, or a :class:`PerceptionError` saying why not.
+
+        ``may_be_lifted``: the gripper may be holding the cube above the table (the support check
+        then allows it to float).
+        """
         o3d, cfg = self.o3d, self.config
         start = time.perf_counter()
         expected = (self.intrinsics.height, self.intrinsics.width)
@@ -233,30 +283,50 @@ class CubePoseEstimator:
         normal, d = self.table_plane(red, depth_m)
         points = points[points @ normal + d > cfg.plane_margin]
         cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
+        if cfg.voxel_size > 0:
+            cloud = cloud.voxel_down_sample(cfg.voxel_size)
+            points = np.asarray(cloud.points)
         labels = np.asarray(cloud.cluster_dbscan(eps=cfg.cluster_eps, min_points=8))
         if labels.size == 0 or labels.max() < 0:
             raise CubeNotVisibleError("cube not visible: the red points form no cluster")
         largest = np.bincount(labels[labels >= 0]).argmax()
         points = points[labels == largest]
-        if len(points) < cfg.min_points:
+        if len(points) < self._min_cluster:
             raise CubeNotVisibleError(f"cube not visible: largest red cluster has {len(points)} points")
         cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
 
-        T_init = self._initial_pose(points, normal)
-        result = o3d.pipelines.registration.registration_icp(
-            cloud,
-            self.model,
-            cfg.icp_max_distance,
-            np.linalg.inv(T_init),  # observed points (base frame) -> cube model frame
-            o3d.pipelines.registration.TransformationEstimationPointToPlane(),
-            o3d.pipelines.registration.ICPConvergenceCriteria(max_iteration=cfg.icp_iterations),
-        )
-        if result.fitness < cfg.min_fitness or result.inlier_rmse > cfg.max_rmse:
-            raise PoseRejectedError(
-                f"ICP fit rejected: fitness {result.fitness:.2f} (need >= {cfg.min_fitness}), "
-                f"RMSE {1000 * result.inlier_rmse:.1f} mm (need <= {1000 * cfg.max_rmse:.1f} mm)"
-            )
-        T = np.linalg.inv(result.transformation)
+        starts = self._initial_poses(points, normal)
+        fits = [self._fit(cloud, points, T_init, depth_m, (normal, d), may_be_lifted) for T_init in starts]
+        if len(starts) > 1:
+            # a partly hidden cube: ICP may slide a good start off; the starts themselves are candidates too
+            fits += [
+                self._fit(cloud, points, T_init, depth_m, (normal, d), may_be_lifted, icp=False) for T_init in starts
+            ]
+        passing = [f for f in fits if not f[2]]
+        if not passing and cfg.consistency is not None:
+            passing = self._slid_off_free_space(fits, points, depth_m, (normal, d), may_be_lifted)
+        if not passing:
+            best = min(fits, key=lambda f: len(f[2]))
+            raise PoseRejectedError("fit rejected: " + "; ".join(best[2]))
+        passing.sort(key=lambda f: f[1].score() if f[1] is not None else 0.0, reverse=True)
+        T, consistency, _, result = passing[0]
+        if cfg.consistency is not None:
+            # every distinct passing fit, moved to the middle of where it may slide: they must agree
+            distinct = []
+            for fit in passing:
+                if all(np.linalg.norm(fit[0][:3, 3] - other[0][:3, 3]) > cfg.same_fit for other in distinct):
+                    distinct.append(fit)
+            centred = [self._centre_in_consistent_interval(f[0], points, depth_m, normal) for f in distinct]
+            T = centred[0]
+        else:
+            centred = [f[0] for f in passing]
+        for other in centred[1:]:
+            gap = np.linalg.norm(other[:3, 3] - T[:3, 3])
+            if gap > cfg.ambiguity_distance:
+                raise AmbiguousPoseError(
+                    f"ambiguous: two fits {1000 * gap:.0f} mm apart both explain the frame "
+                    "(too much of the cube is hidden)"
+                )
         T[:3, :3] = canonical_cube_rotation(T[:3, :3])
         return CubePoseEstimate(
             T_base_cube=T,
@@ -265,4 +335,83 @@ class CubePoseEstimator:
             num_points=len(points),
             seconds=time.perf_counter() - start,
             points=points,
+            consistency=consistency,
+            hypotheses=len(fits),
         )
+
+    @property
+    def _min_cluster(self) -> int:
+        """Points a cube cluster needs after thinning (the raw-pixel minimum, scaled to voxels)."""
+        return self.config.min_points if self.config.voxel_size <= 0 else max(15, self.config.min_points // 4)
+
+    def _slid_off_free_space(self, fits, points, depth_m, table, may_be_lifted) -> list:
+        """Fits that fail only because the camera sees through part of them, slid horizontally until it does not.
+
+        A cube seen mostly from the top can sit an edge's worth off in the direction nothing pins
+        down; moving it back out of the visible free space is the fix, and it is checked again.
+        """
+        repaired = []
+        for T, consistency, failures, result in fits:
+            if consistency is None or len(failures) != 1 or not failures[0].startswith("free space"):
+                continue
+            R = T[:3, :3]
+            vertical = int(np.argmax(np.abs(R.T @ table[0])))
+            for axis in (a for a in range(3) if a != vertical):
+                for shift in np.arange(1, 7) * 0.003:
+                    for sign in (-1.0, 1.0):
+                        moved = T.copy()
+                        moved[:3, 3] += sign * shift * R[:, axis]
+                        check = self.checker.check(moved, points, depth_m, table)
+                        if not check.failures(self.config.consistency, may_be_lifted):
+                            repaired.append((moved, check, [], result))
+        return repaired
+
+    def _centre_in_consistent_interval(self, T, points, depth_m, normal) -> np.ndarray:
+        """Move the fit to the middle of where it may slide along each horizontal cube axis; reject if that is far.
+
+        ICP leaves a cube seen mostly from the top free to slide along it; what pins it down is
+        where its red points end on one side and the visible table begins on the other.
+        """
+        T = T.copy()
+        R = T[:3, :3]
+        vertical = int(np.argmax(np.abs(R.T @ normal)))
+        for axis in (a for a in range(3) if a != vertical):
+            low, high = self.checker.consistent_interval(T, points, depth_m, R[:, axis])
+            if high - low > self.config.consistency.max_interval:
+                raise AmbiguousPoseError(
+                    f"ambiguous: the cube could be anywhere along a {1000 * (high - low):.0f} mm stretch "
+                    f"(max {1000 * self.config.consistency.max_interval:.0f} mm): too much of it is hidden"
+                )
+            T[:3, 3] += R[:, axis] * (low + high) / 2
+        return T
+
+    def _fit(self, cloud, points, T_init, depth_m, table, may_be_lifted, icp: bool = True):
+        """ICP from one start (or the start as it is); ``(T_base_cube, consistency, failures, icp_result)``."""
+        o3d, cfg = self.o3d, self.config
+        registration = (
+            o3d.pipelines.registration.registration_icp
+            if icp
+            else lambda source, target, distance, init, *_: o3d.pipelines.registration.evaluate_registration(
+                source, target, distance, init
+            )
+        )
+        result = registration(
+            cloud,
+            self.model,
+            cfg.icp_max_distance,
+            np.linalg.inv(T_init),  # observed points (base frame) -> cube model frame
+            o3d.pipelines.registration.TransformationEstimationPointToPlane(),
+            o3d.pipelines.registration.ICPConvergenceCriteria(max_iteration=cfg.icp_iterations),
+        )
+        T = np.linalg.inv(result.transformation)
+        failures = []
+        if result.fitness < cfg.min_fitness or result.inlier_rmse > cfg.max_rmse:
+            failures.append(
+                f"ICP fitness {result.fitness:.2f} (need >= {cfg.min_fitness}), "
+                f"RMSE {1000 * result.inlier_rmse:.1f} mm (need <= {1000 * cfg.max_rmse:.1f} mm)"
+            )
+        consistency = None
+        if cfg.consistency is not None:
+            consistency = self.checker.check(T, points, depth_m, table)
+            failures += consistency.failures(cfg.consistency, may_be_lifted)
+        return T, consistency, failures, result
