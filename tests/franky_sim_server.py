@@ -25,14 +25,16 @@ def free_loopback() -> str:
 
 
 @contextmanager
-def franky_sim(cube: tuple[float, float] | None = (0.5, 0.0), timeout: float = 60.0):
-    """Yield the host of a running franky-sim server; kill its process group afterwards."""
+def franky_sim(cube: tuple[float, float] | None = (0.5, 0.0), timeout: float = 60.0, scene_port: int | None = None):
+    """Yield the running franky-sim server (``.host``; ``.scene_port`` when asked for); kill it afterwards."""
     if not PYTHON.exists():
         raise RuntimeError(f"franky-sim's environment is missing ({PYTHON}); run `make setup` (scripts/setup.sh)")
     host = free_loopback()
     command = [str(PYTHON), str(SERVE), "--hostname", host]
     if cube is not None:
         command += ["--cube", str(cube[0]), str(cube[1])]
+    if scene_port is not None:
+        command += ["--scene-port", str(scene_port)]
     proc = subprocess.Popen(
         command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True
     )
@@ -51,6 +53,7 @@ def franky_sim(cube: tuple[float, float] | None = (0.5, 0.0), timeout: float = 6
         if proc.poll() is not None:
             raise RuntimeError("franky-sim exited:\n" + "".join(lines))
         proc.host = host
+        proc.scene_port = scene_port
         yield proc
     finally:
         stop(proc)

@@ -47,6 +47,18 @@ class TruthPerceptionConfig(PerceptionConfig):
     """The simulator's true cube pose (sim only)."""
 
 
+@PerceptionConfig.register_subclass("franky_sim")
+@dataclass
+class FrankySimPerceptionConfig(PerceptionConfig):
+    """franky-sim's own cube pose over its scene channel (rehearsals through the franky backend).
+
+    franky-sim has no camera; this stands in for one as ``truth`` does in the MuJoCo rehearsal,
+    and the same channel places the cube for igen-eval's trial i and judges the lift.
+    """
+
+    port: int = 7711  # tools/franky_sim/serve.py --scene-port
+
+
 @PerceptionConfig.register_subclass("realsense")
 @dataclass
 class RealSensePerceptionConfig(PerceptionConfig):
@@ -105,12 +117,20 @@ class DeployConfig:
                 f"--perception.type={self.perception.get_choice_name(type(self.perception))} needs the simulated "
                 "arm (--robot.type=sim); a real arm needs --perception.type=realsense"
             )
-        if self.compare_sim and not self.robot.simulated:
-            raise ConfigError("--compare_sim=true needs --robot.type=sim")
+        franky_sim = isinstance(self.perception, FrankySimPerceptionConfig)
+        if franky_sim and self.robot.get_choice_name(type(self.robot)) != "franky":
+            raise ConfigError("--perception.type=franky_sim needs --robot.type=franky (pointed at franky-sim)")
+        if self.compare_sim and not (self.robot.simulated or franky_sim):
+            raise ConfigError("--compare_sim=true needs a rehearsal: --robot.type=sim, or franky with franky_sim")
         if self.realtime is None:
             self.realtime = not self.robot.simulated
         if self.prompt is None:
-            self.prompt = not self.robot.simulated
+            self.prompt = not (self.robot.simulated or franky_sim)
+
+    @property
+    def rehearsal(self) -> bool:
+        """Trials are igen-eval's situations (the MuJoCo arm, or franky-sim with its scene channel)."""
+        return self.robot.simulated or isinstance(self.perception, FrankySimPerceptionConfig)
 
     def real_world_from_base(self) -> np.ndarray:
         T = np.eye(4)

@@ -1,8 +1,11 @@
 """Trials of a policy on an arm: build the parts from a :class:`DeployConfig`, run, summarise.
 
-A rehearsal (``--robot.type=sim``) runs trial ``i`` on igen-eval's scene ``i`` with the same pose
-error, so ``--compare_sim=true`` can report the deployment path's success next to the policy's
-own sim success on identical situations: the two should agree within sampling noise.
+A rehearsal runs trial ``i`` on igen-eval's scene ``i`` with the same pose error, so
+``--compare_sim=true`` can report the deployment path's success next to the policy's own sim
+success on identical situations. Two rehearsals exist: the MuJoCo arm (``--robot.type=sim``, the
+training simulator itself) and the franky backend against franky-sim (``--robot.type=franky
+--perception.type=franky_sim``: a different simulator behind the real driver stack, whose cube is
+placed per trial through its scene channel).
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.belief import check_deployable, cube_belief
 from lerobot_robot_igen.config_deploy import (
     DeployConfig,
+    FrankySimPerceptionConfig,
     RealSensePerceptionConfig,
     RenderedPerceptionConfig,
     TruthPerceptionConfig,
@@ -61,6 +65,8 @@ def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
     p = cfg.perception
     if isinstance(p, TruthPerceptionConfig):
         return pose_source.SimTruthPose(driver)
+    if isinstance(p, FrankySimPerceptionConfig):
+        return pose_source.FrankySimCubePose(cfg.robot.host, p.port)
     if isinstance(p, RenderedPerceptionConfig):
         return pose_source.RenderedICPPose(driver, p.distance, p.azimuth_deg, p.elevation_deg, p.noise)
     if isinstance(p, RealSensePerceptionConfig):
@@ -98,6 +104,16 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
     env_cfg = BlockGraspEnvConfig()
     check_deployable(env_cfg.task_spec)
     policy = make_base_policy(cfg.policy, env_cfg)
+    # the task's MuJoCo scene is needed before the arm: igen-eval's rollouts for --compare_sim, and the
+    # situations a franky-sim rehearsal recreates (done first, so no arm idles connected meanwhile)
+    sim_result = None
+    if cfg.compare_sim:
+        env = env_cfg.make_task_env()
+        try:
+            sim_result = evaluate(env, policy, "sim", cfg.trials, cfg.seed, cfg.max_steps)
+        finally:
+            env.close()
+    situations = _trial_situations(env_cfg, cfg) if isinstance(cfg.perception, FrankySimPerceptionConfig) else None
     driver = cfg.robot.make_driver()
     driver.connect()
     simulated = cfg.robot.simulated
@@ -142,6 +158,8 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
                     driver.reset_scene(seed)
                     offset = driver.env.corruption  # igen-eval's trial i: same scene, same pose error
                     judge = _sim_judge(driver)
+                elif situations is not None:
+                    offset, judge = _franky_sim_trial(driver, poses.scene, situations[i], world_from_base)
                 else:
                     if cfg.prompt:
                         input(f"trial {i + 1}/{cfg.trials}: place the cube, clear the workspace, press Enter ")
@@ -170,14 +188,13 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         "loop": {"step": timing_stats(step_times), "period": timing_stats(period_times)},
         "seconds": time.perf_counter() - started,
     }
-    if cfg.compare_sim:
-        env = env_cfg.make_task_env()
-        try:
-            result = evaluate(env, policy, "sim", cfg.trials, cfg.seed, cfg.max_steps)
-        finally:
-            env.close()
-        report["sim"] = {"success_rate": result.success_rate, "ci95": result.ci95, "successes": result.successes}
-        report["per_trial_sim"] = result.per_trial
+    if sim_result is not None:
+        report["sim"] = {
+            "success_rate": sim_result.success_rate,
+            "ci95": sim_result.ci95,
+            "successes": sim_result.successes,
+        }
+        report["per_trial_sim"] = sim_result.per_trial
     return report
 
 
@@ -211,6 +228,37 @@ def deploy_logger(viz: EpisodeLogger, arm: SafeArm):
         state["step"] += 1
 
     return log
+
+
+def _trial_situations(env_cfg, cfg: DeployConfig) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``(T_world_cube, pose error)`` of igen-eval's trials 0..trials-1 (what a franky-sim rehearsal recreates)."""
+    env = env_cfg.make_task_env()
+    try:
+        situations = []
+        for i in range(cfg.trials):
+            env.reset(episode_seed(cfg.seed, i))
+            situations.append((env.true_object_poses()["cube"].copy(), np.asarray(env.corruption, float).copy()))
+        return situations
+    finally:
+        env.close()
+
+
+def _franky_sim_trial(driver, scene, situation, world_from_base: np.ndarray):
+    """One igen-eval trial on franky-sim: the arm home, the cube where the trial has it; its pose error and judge."""
+    from lerobot_env_igen.block_grasp.spec import CUBE_HALF
+    from lerobot_robot_igen.backends.franky_sim_scene import LIFT_SUCCESS
+
+    T_world_cube, corruption = situation
+    driver.move_home()
+    T_base_cube = np.linalg.inv(world_from_base) @ T_world_cube
+    scene.place_cube(T_base_cube[0, 3], T_base_cube[1, 3], float(np.arctan2(T_base_cube[1, 0], T_base_cube[0, 0])))
+    cube = 2 * CUBE_HALF
+
+    def judge(state: ArmState, action: np.ndarray) -> bool:
+        held = 0.6 * cube <= state.gripper_width <= 1.1 * cube
+        return held and scene.lifted() >= LIFT_SUCCESS
+
+    return corruption, judge
 
 
 def _sim_judge(driver):

@@ -52,6 +52,21 @@ class SimTruthPose(PoseSource):
         return PoseReading(T_base_cube=self.arm.true_cube_pose())
 
 
+class FrankySimCubePose(PoseSource):
+    """franky-sim's cube over its scene channel (a franky rehearsal's stand-in for the camera)."""
+
+    def __init__(self, host: str, port: int) -> None:
+        from lerobot_robot_igen.backends.franky_sim_scene import FrankySimScene
+
+        self.scene = FrankySimScene(host, port)
+
+    def read(self) -> PoseReading:
+        return PoseReading(T_base_cube=self.scene.cube_pose())
+
+    def close(self) -> None:
+        self.scene.close()
+
+
 class RenderedICPPose(PoseSource):
     """A D415 rendered from the simulated scene, through the real ICP estimator.
 

@@ -1,12 +1,22 @@
 """franky-sim's FR3 server on one loopback address, optionally with a 5 cm cube on the floor.
 
 Runs in this folder's own environment (mujoco 4): ``tools/franky_sim/.venv/bin/python
-tools/franky_sim/serve.py --hostname 127.0.0.1 [--cube 0.5 0.0]``. It is what
+tools/franky_sim/serve.py --hostname 127.0.0.1 [--cube 0.5 0.0] [--scene-port 7711]``. It is what
 ``python -m franky_sim.run_server --simulator mujoco --hostname ...`` runs, plus the cube
 (the standard server has an empty scene). Prints ``READY`` once the robot answers.
+
+``--scene-port`` also serves the cube over TCP on the same address, one JSON object per line:
+``{"cmd": "cube"}`` answers its pose (``pos`` [m], ``quat_wxyz``, robot base frame) and
+``{"cmd": "place", "x": .., "y": .., "yaw": ..}`` puts it back on the floor there, at rest. This
+stands in for the camera a real cell has (franky-sim renders none) and lets a rehearsal place the
+cube per trial without restarting the robot.
 """
 
 import argparse
+import json
+import math
+import socketserver
+import threading
 import xml.etree.ElementTree as ET
 
 import franky_sim
@@ -18,6 +28,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--hostname", default="127.0.0.1")
     parser.add_argument("--cube", type=float, nargs=2, default=None, metavar=("X", "Y"), help="cube position [m]")
+    parser.add_argument("--scene-port", type=int, default=None, help="serve the cube's pose and placement here")
     args = parser.parse_args()
     with MujocoSimulator(enable_visualization=False) as sim:
         if args.cube is not None:
@@ -28,8 +39,46 @@ def main() -> None:
             ET.SubElement(cube, "geom", friction="1.5 0.01 0.001", **box)
         sim.add_robot()
         with franky_sim.SimulationServer(sim, hostname_candidates=[args.hostname]) as server:
+            if args.scene_port is not None and args.cube is not None:
+                scene = socketserver.ThreadingTCPServer((args.hostname, args.scene_port), _scene_handler(sim))
+                scene.daemon_threads = True
+                threading.Thread(target=scene.serve_forever, name="cube-scene", daemon=True).start()
             print("READY", flush=True)
             server.run_forever()
+
+
+def _scene_handler(sim):
+    """A request handler answering "cube" and "place" for the cube of ``sim``."""
+    import mujoco
+
+    class Handler(socketserver.StreamRequestHandler):
+        def handle(self) -> None:
+            for line in self.rfile:
+                request = json.loads(line)
+                model, data = sim.model, sim.data
+                body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "cube")
+                joint = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "cube_joint")]
+                dof = model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "cube_joint")]
+                if request["cmd"] == "cube":
+                    reply = {"pos": data.xpos[body].tolist(), "quat_wxyz": data.xquat[body].tolist()}
+                elif request["cmd"] == "place":
+                    half = request.get("yaw", 0.0) / 2
+                    data.qpos[joint : joint + 7] = [
+                        request["x"],
+                        request["y"],
+                        0.025,
+                        math.cos(half),
+                        0,
+                        0,
+                        math.sin(half),
+                    ]
+                    data.qvel[dof : dof + 6] = 0.0
+                    reply = {"ok": True}
+                else:
+                    reply = {"error": f"unknown cmd {request['cmd']!r}; use cube or place"}
+                self.wfile.write((json.dumps(reply) + "\n").encode())
+
+    return Handler
 
 
 if __name__ == "__main__":

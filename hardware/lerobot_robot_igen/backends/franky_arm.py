@@ -55,10 +55,14 @@ class FrankyArmConfig(ArmBackendConfig):
     grasp_force: float = 20.0  # [N]
     gripper_speed: float = 0.1  # [m/s]
     open_width: float = 0.08  # [m]
+    gripper_timeout: float = 5.0  # [s] the longest a gripper command may take before the next is sent
     tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
 
     def make_driver(self) -> ArmDriver:
         return FrankyArm(self)
+
+
+_STILL_RUNNING: list = []  # gripper commands that outlived their driver, kept so their threads never see freed memory
 
 
 class FrankyArm(ArmDriver):
@@ -125,6 +129,17 @@ class FrankyArm(ArmDriver):
                 self.stop()
             except DriverError as error:  # a reflex: the arm is already stopped
                 logger.warning("stopping before disconnect failed: %s", error)
+        if self._pending is not None:
+            # a gripper command still running uses the Gripper from its own thread: freeing the
+            # Gripper under it crashes the process, so let it finish (bounded), and if it does not,
+            # keep both alive for the life of the process
+            try:
+                finished = bool(self._pending.wait(self.config.gripper_timeout))
+            except Exception:  # noqa: BLE001 - a failed grasp is finished too
+                finished = True
+            if not finished:
+                _STILL_RUNNING.append((self.gripper, self._pending))
+            self._pending = None
         self.robot = self.gripper = None
 
     @property
@@ -163,6 +178,10 @@ class FrankyArm(ArmDriver):
         cfg = self.config
         if closed == self._gripper_closed:
             return
+        if self._pending is not None:
+            # the gripper runs one command at a time: a new one sent while a grasp is still closing
+            # (or failing on air) blocks until that finishes, so wait for it here, bounded
+            self._call("the previous gripper command", self._pending.wait, cfg.gripper_timeout)
         if closed:
             self._pending = self._call(
                 "a grasp",
