@@ -1,5 +1,6 @@
 """Cube pose from RGB-D with Open3D ICP, on MuJoCo renders of the Block Grasp scene with known truth:
-accuracy with depth noise and gripper occlusion, the symmetry convention, and every fault path."""
+the symmetry convention, a RealSense recording, and every fault path (accuracy on D415-model frames
+with occluders: tests/test_perception_trust.py)."""
 
 import json
 
@@ -27,33 +28,6 @@ def scene(block_grasp_config):
     yield env, camera, Intrinsics(*camera.intrinsics())
     camera.close()
     env.close()
-
-
-def _rotation_error_deg(R_a, R_b):
-    return float(np.rad2deg(np.arccos(np.clip((np.trace(R_a.T @ R_b) - 1) / 2, -1, 1))))
-
-
-def test_accuracy_with_depth_noise_and_gripper_occlusion(scene):
-    """Targets: median position error <= 2 mm, p95 <= 5 mm; rotation (modulo symmetry) median <= 2 deg."""
-    from lerobot_env_igen.rgbd import random_cube_view
-
-    env, camera, intrinsics = scene
-    rng = np.random.default_rng(0)
-    errors_mm, rotation_deg, occluded_points, open_points = [], [], [], []
-    for i in range(16):
-        occlude = i % 2 == 1
-        rgb, depth, T_world_camera, T_world_cube = random_cube_view(env, camera, rng, 0.001, occlude=occlude)
-        estimate = CubePoseEstimator(intrinsics, T_world_camera).estimate(rgb, depth)
-        errors_mm.append(1000 * np.linalg.norm(estimate.position - T_world_cube[:3, 3]))
-        rotation_deg.append(
-            _rotation_error_deg(canonical_cube_rotation(T_world_cube[:3, :3]), estimate.T_base_cube[:3, :3])
-        )
-        (occluded_points if occlude else open_points).append(estimate.num_points)
-    assert np.median(errors_mm) <= 2.0, errors_mm
-    assert np.percentile(errors_mm, 95) <= 5.0, errors_mm
-    assert np.median(rotation_deg) <= 2.0, rotation_deg
-    # the occluded views really are occluded: the gripper hides part of the cube
-    assert np.median(occluded_points) < np.median(open_points)
 
 
 def test_symmetric_rotations_collapse_to_one_canonical_pose():

@@ -64,9 +64,9 @@ def test_a_20hz_stream_of_absolute_targets_is_followed(empty_sim):
     try:
         arm.move_home()
         _, T_start = safe.read()
-        # 8 cm legs: the first delta of the way back must stay inside refuse_delta (10 cm) even if the
+        # 6 cm legs: the first delta of the way back must stay inside refuse_delta (10 cm) even if the
         # arm overshoots the far goal by a little
-        goal_out = T_start[:3, 3] + np.array([0.08, 0.0, 0.0])
+        goal_out = T_start[:3, 3] + np.array([0.06, 0.0, 0.0])
         calls, ticks = [], []
         for goal in (goal_out, T_start[:3, 3]):
             for _ in range(40):  # 2 s per leg
@@ -210,7 +210,7 @@ def test_igen_deploy_rehearses_igen_evals_trials_through_franky_on_franky_sim():
             robot=FrankyArmConfig(host=server.host),
             perception=FrankySimPerceptionConfig(port=server.scene_port),
             trials=2,
-            max_steps=60,
+            max_steps=30,
             compare_sim=True,
         )
         assert cfg.realtime and not cfg.prompt and cfg.rehearsal
