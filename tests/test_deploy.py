@@ -330,10 +330,18 @@ def test_trial_seeds_are_igen_evals(sim_arm, block_grasp_config):
     env.close()
 
 
-def test_deployment_logs_to_rerun(tmp_path):
-    """Camera images, the segmented cloud, ICP change, commanded vs measured hand, every period."""
+def rrd_rows(path) -> dict[str, int]:
+    """Rows logged per entity in a Rerun recording, read back with Rerun's own reader."""
     from rerun.experimental import RrdReader
 
+    rows: dict[str, int] = {}
+    for chunk in RrdReader(path).stream():
+        rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
+    return rows
+
+
+def test_deployment_logs_to_rerun(tmp_path):
+    """Camera images, the segmented cloud, ICP change, commanded vs measured hand, every period."""
     from igen_lerobot.viz.rerun_log import RerunConfig
     from lerobot_robot_igen.config_deploy import RenderedPerceptionConfig
 
@@ -346,9 +354,7 @@ def test_deployment_logs_to_rerun(tmp_path):
         rerun=RerunConfig(mode="save", path=str(out)),
     )
     deploy(cfg)
-    rows: dict[str, int] = {}
-    for chunk in RrdReader(out).stream():
-        rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
+    rows = rrd_rows(out)
     for entity in ("eef/measured", "eef/commanded", "cube/believed", "cube/perceived", "camera/color", "camera/depth"):
         assert rows.get(f"/deploy/{entity}") == 12, (entity, rows.get(f"/deploy/{entity}"))
     assert rows.get("/deploy/cube/cloud") == 12 and rows.get("/deploy/cube/icp_change_mm") == 11
@@ -424,8 +430,6 @@ def test_pose_gate_settings_name_the_field():
 
 
 def test_rejected_estimates_reach_rerun_and_the_report(tmp_path, monkeypatch):
-    from rerun.experimental import RrdReader
-
     from igen_lerobot.viz.rerun_log import RerunConfig
     from lerobot_robot_igen import deploy as deploy_module
 
@@ -441,7 +445,5 @@ def test_rejected_estimates_reach_rerun_and_the_report(tmp_path, monkeypatch):
     report = deploy(cfg)
     trial = report["per_trial"][0]
     assert trial["rejected_jumps"] == 4 and [r["step"] for r in trial["pose_rejections"]] == [2, 5, 8, 11]
-    rows: dict[str, int] = {}
-    for chunk in RrdReader(out).stream():
-        rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
+    rows = rrd_rows(out)
     assert rows.get("/deploy/perception/rejections") == 4 and rows.get("/deploy/cube/estimate_used") == 12

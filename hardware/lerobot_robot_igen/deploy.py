@@ -36,6 +36,11 @@ from lerobot_robot_igen.pose_source import PoseSource
 logger = logging.getLogger(__name__)
 
 
+def holds_cube(gripper_width: float, cube_size: float) -> bool:
+    """The fingers stopped on something cube-sized (not closed on air, not wide open)."""
+    return 0.6 * cube_size <= gripper_width <= 1.1 * cube_size
+
+
 class GraspLiftJudge:
     """Success on a real arm: the gripper closed on something cube-sized and lifted it 4 cm.
 
@@ -48,7 +53,7 @@ class GraspLiftJudge:
 
     def __call__(self, state: ArmState, action: np.ndarray) -> bool:
         closed = bool(action[3] > 0.0)
-        holding = closed and 0.6 * self.cube_size <= state.gripper_width <= 1.1 * self.cube_size
+        holding = closed and holds_cube(state.gripper_width, self.cube_size)
         if not holding:
             self._grasp_z = None
             return False
@@ -255,8 +260,7 @@ def _franky_sim_trial(driver, scene, situation, world_from_base: np.ndarray):
     cube = 2 * CUBE_HALF
 
     def judge(state: ArmState, action: np.ndarray) -> bool:
-        held = 0.6 * cube <= state.gripper_width <= 1.1 * cube
-        return held and scene.lifted() >= LIFT_SUCCESS
+        return holds_cube(state.gripper_width, cube) and scene.lifted() >= LIFT_SUCCESS
 
     return corruption, judge
 
