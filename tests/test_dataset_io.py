@@ -12,7 +12,7 @@ from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError, TaskMismatchError
 from igen_lerobot.core.task import FrameSource
 from igen_lerobot.datasets.reader import load_episodes, read_igen_meta
-from igen_lerobot.datasets.schema import FRAME_SOURCE, IS_INTERVENTION, dataset_features
+from igen_lerobot.datasets.schema import FRAME_SOURCE, IS_INTERVENTION, SIM_STATE, dataset_features
 from igen_lerobot.datasets.writer import DatasetBuilder
 
 
@@ -198,6 +198,9 @@ def test_a_block_grasp_dataset_written_before_the_core_held_several_tasks_still_
     rewards = np.array(dataset.hf_dataset["next.reward"]).reshape(-1)
     assert rewards.sum() == 2 + len(kept)  # one per successful episode, the old ones included
     assert "next.reward" not in json.loads((old / "meta" / "info.json").read_text())["features"]
+    # the new part carries simulator states, the old one cannot: the merge keeps none (and says so)
+    assert SIM_STATE in LeRobotDataset("local/new", root=tmp_path / "new").meta.features
+    assert SIM_STATE not in dataset.meta.features and "sim_state_layout" not in read_igen_meta(merged).meta
 
 
 def test_lerobots_rl_replay_buffer_loads_our_dataset_with_the_intervention_flags(tmp_path, spec):

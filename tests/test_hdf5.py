@@ -140,6 +140,7 @@ def test_ours_to_hdf5_and_back_gives_identical_episodes(fake_demos, tmp_path, so
             demo = f["data/demo_0"]
             assert {"actions", "rewards", "dones", "obs", "datagen_info", IGEN_GROUP} <= set(demo)
             assert demo["datagen_info/eef_pose"].shape[1:] == (4, 4)
+            assert ("states" in demo) == (root != tmp_path / "fake")
             assert f["data"].attrs["total"] == sum(f[f"data/{d}/actions"].shape[0] for d in f["data"])
         back = tmp_path / f"{root.name}_back"
         code, err = cli("igen-import", f"--input={out}", env, f"--dataset.root={back}")
@@ -153,6 +154,9 @@ def test_ours_to_hdf5_and_back_gives_identical_episodes(fake_demos, tmp_path, so
                 np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
             for key in ("is_intervention", "source", "subtask"):
                 np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+            assert (a.sim_state is None) == (b.sim_state is None) == (root.name.startswith("fake"))
+            if a.sim_state is not None:  # the simulator states travel too (robomimic's "states")
+                np.testing.assert_array_equal(a.sim_state, b.sim_state)
 
 
 def test_bad_files_are_refused_with_the_reason_and_nothing_is_written(fake_demos, tmp_path):

@@ -47,6 +47,7 @@ class Episode:
     true_object_pose: np.ndarray  # (T, 7 * n_objects) privileged truth: position + quat xyzw
     success: bool
     extra: dict = field(default_factory=dict)  # JSON-able facts (e.g. source episode used)
+    sim_state: np.ndarray | None = None  # (T, K) float64 simulator state per frame (re-rendering); None: not recorded
 
     @property
     def length(self) -> int:
@@ -77,6 +78,8 @@ class Episode:
                 raise DatasetSchemaError(
                     f"episode.{name} has shape {value.shape}, expected {shape} for task {spec.name!r}"
                 )
+        if self.sim_state is not None and (np.ndim(self.sim_state) != 2 or len(self.sim_state) != n):
+            raise DatasetSchemaError(f"episode.sim_state has shape {np.shape(self.sim_state)}, expected ({n}, K)")
         for name in ("state", "env_state", "action", "true_object_pose"):
             if not np.all(np.isfinite(getattr(self, name))):
                 raise DatasetSchemaError(f"episode.{name} contains NaN or inf")
@@ -95,9 +98,11 @@ class Episode:
             "success": bool(self.success),
             "extra": self.extra,
         }
+        optional = {} if self.sim_state is None else {"sim_state": self.sim_state}
         with open(tmp, "wb") as f:
             np.savez(
                 f,
+                **optional,
                 meta=np.array(json.dumps(meta)),
                 corruption=self.corruption,
                 state=self.state,
@@ -129,4 +134,5 @@ class Episode:
                 source=z["source"],
                 subtask=z["subtask"],
                 true_object_pose=z["true_object_pose"],
+                sim_state=z["sim_state"] if "sim_state" in z.files else None,
             )

@@ -24,6 +24,7 @@ class EpisodeRecorder:
         self.source: list[int] = []
         self.subtask: list[int] = []
         self.truth: list[np.ndarray] = []
+        self.sim: list[np.ndarray] = []
 
     def record(self, obs: dict[str, np.ndarray], action: np.ndarray, source: FrameSource, flagged: bool) -> None:
         self.state.append(obs[OBS_STATE])
@@ -33,6 +34,9 @@ class EpisodeRecorder:
         self.source.append(int(source))
         self.subtask.append(min(self.env.subtask_index(), len(self.env.spec.subtasks) - 1))
         self.truth.append(self.env.true_object_pose_vector())
+        sim = self.env.sim_state()
+        if sim is not None:
+            self.sim.append(sim)
 
     def __len__(self) -> int:
         return len(self.action)
@@ -51,6 +55,7 @@ class EpisodeRecorder:
             source=np.asarray(self.source[start:], dtype=np.int64),
             subtask=np.asarray(self.subtask[start:], dtype=np.int64),
             true_object_pose=np.asarray(self.truth[start:], dtype=np.float32),
+            sim_state=np.asarray(self.sim[start:], dtype=np.float64) if self.sim else None,
             success=success,
             extra=dict(extra),
         )

@@ -285,5 +285,21 @@ class TaskEnv(abc.ABC):
         poses = self.true_object_poses()
         return np.concatenate([pose_vector(poses[name]) for name in self.spec.objects])
 
+    # ------------------------------------------------------------------ simulator state
+    def sim_state(self) -> np.ndarray | None:
+        """Everything needed to restore this instant exactly (float64), or None where there is no simulator.
+
+        Recorded on every frame so a dataset can be re-rendered later with any camera.
+        """
+        return None
+
+    def sim_state_layout(self) -> dict | None:
+        """What a :meth:`sim_state` vector holds (stored with the dataset; restoring checks it matches)."""
+        return None
+
+    def restore_sim_state(self, state: np.ndarray) -> None:
+        """Put the simulator back into a recorded :meth:`sim_state`."""
+        raise NotImplementedError(f"task {self.spec.name!r} has no simulator state to restore")
+
     def close(self) -> None:  # noqa: B027 - optional hook, most envs hold no resources.
         """Release simulator or hardware resources."""

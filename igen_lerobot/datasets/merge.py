@@ -21,7 +21,7 @@ from igen_lerobot.core.exceptions import ConfigError, TaskMismatchError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_merge import MergeConfig
 from igen_lerobot.datasets.reader import check_features, dataset_spec, read_igen_meta
-from igen_lerobot.datasets.schema import RL_COLUMNS, SCHEMA_VERSION
+from igen_lerobot.datasets.schema import RL_COLUMNS, SCHEMA_VERSION, SIM_STATE
 from igen_lerobot.datasets.writer import IGEN_META_FILE, running_command, write_lerobot_dataset
 
 logger = logging.getLogger(__name__)
@@ -64,7 +64,7 @@ def merge_datasets(
     output_root = Path(output_root)
     if output_root.exists() and not overwrite:
         raise ConfigError(f"{output_root} exists; pick another output or pass overwrite")
-    metas, frames, outdated = [], [], []
+    metas, frames, outdated, with_sim = [], [], [], []
     for root in roots:
         info = read_igen_meta(root, "--inputs")
         if info.task != spec.name:
@@ -82,6 +82,13 @@ def merge_datasets(
         metas.append(info.meta)
         frames.append(lerobot_meta.total_frames)
         outdated.append(not all(key in lerobot_meta.features for key in RL_COLUMNS))
+        with_sim.append(SIM_STATE in lerobot_meta.features)
+    # simulator states survive a merge only if every part has them (LeRobot aggregates equal features)
+    keep_sim = all(with_sim)
+    if any(with_sim) and not keep_sim:
+        lacking = [str(r) for r, has in zip(roots, with_sim, strict=True) if not has]
+        logger.warning("%s carry no simulator states: the merged dataset drops them and cannot be re-rendered", lacking)
+    outdated = [old or (has and not keep_sim) for old, has in zip(outdated, with_sim, strict=True)]
     repeats = weighted_repeats(frames, weights) if weights is not None else [1] * len(roots)
     work = output_root.with_name(output_root.name + ".partial")
     if work.exists():
@@ -89,9 +96,10 @@ def merge_datasets(
     work.mkdir(parents=True)
     build = work / "lerobot"
     # LeRobot aggregates datasets of equal features only: one written before next.reward/next.done
-    # is rewritten with them (into the work folder; the input stays as it is)
+    # (or with simulator states the others lack) is rewritten in the common schema (into the work
+    # folder; the input stays as it is)
     sources = [
-        _with_rl_columns(root, spec, work / f"upgraded_{i}") if old else root
+        _in_common_schema(root, spec, work / f"upgraded_{i}", keep_sim) if old else root
         for i, (root, old) in enumerate(zip(roots, outdated, strict=True))
     ]
     parts = [(r, n) for r, n in zip(sources, repeats, strict=True) for _ in range(n)]
@@ -112,6 +120,7 @@ def merge_datasets(
         "episode_kinds": kinds,
         "created_by": "merge",
         "command": running_command(),
+        **({"sim_state_layout": metas[0].get("sim_state_layout")} if keep_sim else {}),
         "parts": [
             {
                 "root": str(r),
@@ -145,12 +154,18 @@ def run_merge(cfg: MergeConfig) -> Path:
     return merged
 
 
-def _with_rl_columns(root: Path, spec: TaskSpec, into: Path) -> Path:
-    """A copy of the dataset at ``root`` in the current schema (LeRobot's RL columns added)."""
+def _in_common_schema(root: Path, spec: TaskSpec, into: Path, keep_sim: bool) -> Path:
+    """A copy of the dataset at ``root`` in the current schema, simulator states kept only if ``keep_sim``.
+
+    LeRobot's RL columns are added to a dataset written before they existed.
+    """
     from igen_lerobot.datasets.reader import load_episodes
 
-    logger.info("%s predates next.reward/next.done: rewriting it with them for the merge", root)
+    logger.info("rewriting %s in the merged dataset's schema", root)
     episodes = load_episodes(root, spec, flag="--inputs")
+    if not keep_sim:
+        for episode in episodes:
+            episode.sim_state = None
     old = read_igen_meta(root).meta
     meta = {**old, "upgraded_from_schema": old.get("schema_version")}
     write_lerobot_dataset(

@@ -24,6 +24,7 @@ from igen_lerobot.datasets.schema import (
     FRAME_SOURCE,
     IGEN_COLUMNS,
     IS_INTERVENTION,
+    SIM_STATE,
     SUBTASK_INDEX,
     TRUE_OBJECT_POSE,
     dataset_features,
@@ -148,9 +149,10 @@ def load_episodes(
     check_features(dataset.meta.features, spec, root, flag)
     # Arrow columns, converted once: datasets' numpy formatting takes ~10 s per column at 60k frames.
     table = dataset.hf_dataset.with_format("arrow")
-    columns = {
-        key: _column_array(table[key]) for key in (OBS_STATE, OBS_ENV_STATE, ACTION, *IGEN_COLUMNS, "episode_index")
-    }
+    keys = (OBS_STATE, OBS_ENV_STATE, ACTION, *IGEN_COLUMNS, "episode_index")
+    if SIM_STATE in dataset.meta.features:
+        keys = (*keys, SIM_STATE)
+    columns = {key: _column_array(table[key]) for key in keys}
     if len(columns["episode_index"]) == 0:
         raise DatasetSchemaError(f"{root} has no frames; record some episodes first")
     out: list[Episode] = []
@@ -177,6 +179,7 @@ def load_episodes(
                 true_object_pose=col(TRUE_OBJECT_POSE).astype(float),
                 success=bool(col(EPISODE_SUCCESS).reshape(-1)[0]),
                 extra={"episode_index": int(episode_index[rows[0]])},
+                sim_state=col(SIM_STATE).astype(np.float64) if SIM_STATE in columns else None,
             )
         )
     return out

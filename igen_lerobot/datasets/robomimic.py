@@ -170,6 +170,7 @@ def _episode_from_igen(group, spec: TaskSpec, where: str) -> Episode:
     if meta["task"] != spec.name:
         raise DatasetSchemaError(f"{where} was exported from task {meta['task']!r}, not {spec.name!r}")
     fields = {k: _array(group, k, where) for k in EPISODE_ARRAYS}
+    fields["sim_state"] = np.asarray(group["sim_state"][()]) if "sim_state" in group else None
     return Episode(task=meta["task"], kind=meta["kind"], seed=meta["seed"], success=meta["success"], **fields)
 
 
@@ -268,3 +269,7 @@ def _write_demo(group, ep: Episode, spec: TaskSpec, actions: ActionSpace) -> Non
     ours.attrs["meta"] = json.dumps(meta)
     for key in EPISODE_ARRAYS:
         ours.create_dataset(key, data=np.asarray(getattr(ep, key)))
+    if ep.sim_state is not None:
+        # robomimic's ``states`` are the simulator states to reset to; ours, in our layout (meta/igen.json)
+        group.create_dataset("states", data=ep.sim_state)
+        ours.create_dataset("sim_state", data=ep.sim_state)

@@ -21,10 +21,13 @@ every frame of the episode for the same reason.
 | complementary_info.success | bool (1,) | whether the episode ended in success |
 | next.reward | float32 (1,) | LeRobot's RL reward: 1.0 on the last frame of a successful episode, else 0 |
 | next.done | bool (1,) | LeRobot's RL episode end: True on the last frame |
+| complementary_info.sim_state | float64 (K,) | simulator state that restores the frame (layout: meta/igen.json) |
 
 ``next.reward`` and ``next.done`` follow LeRobot's RL conventions (``lerobot.rl.buffer.ReplayBuffer``
 loads igen datasets with the intervention flags carried over as complementary info). Datasets
-written before they existed (schema version 1) lack them and still load.
+written before they existed (schema version 1) lack them and still load. ``sim_state`` (schema
+version 3) is written whenever the task has a simulator; datasets without it load as before but
+cannot be re-rendered.
 """
 
 from __future__ import annotations
@@ -34,9 +37,10 @@ from collections.abc import Iterator
 import numpy as np
 
 from igen_lerobot.core.episode import Episode, EpisodeKind
+from igen_lerobot.core.exceptions import DatasetSchemaError
 from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, FrameSource, TaskSpec
 
-SCHEMA_VERSION = 2  # 2: next.reward and next.done
+SCHEMA_VERSION = 3  # 2: next.reward and next.done; 3: complementary_info.sim_state
 IS_INTERVENTION = "complementary_info.is_intervention"
 FRAME_SOURCE = "complementary_info.frame_source"
 SUBTASK_INDEX = "complementary_info.subtask_index"
@@ -45,6 +49,7 @@ CORRUPTION = "complementary_info.corruption"
 EPISODE_SEED = "complementary_info.episode_seed"
 EPISODE_KIND = "complementary_info.episode_kind"
 EPISODE_SUCCESS = "complementary_info.success"
+SIM_STATE = "complementary_info.sim_state"
 
 REWARD = "next.reward"
 DONE = "next.done"
@@ -70,6 +75,11 @@ SCHEMA_DOC_ROWS = (
     ("`complementary_info.success`", "bool (1)", "whether the episode ended in success"),
     ("`next.reward`", "float32 (1)", "LeRobot's RL reward: 1.0 on a successful episode's last frame, else 0"),
     ("`next.done`", "bool (1)", "LeRobot's RL episode end: true on the last frame"),
+    (
+        "`complementary_info.sim_state`",
+        "float64 (K)",
+        "the simulator state that restores the frame exactly (for re-rendering cameras); layout in meta/igen.json",
+    ),
 )
 
 IGEN_COLUMNS = (
@@ -84,9 +94,9 @@ IGEN_COLUMNS = (
 )
 
 
-def dataset_features(spec: TaskSpec) -> dict[str, dict]:
-    """LeRobot ``features`` for a task's interventional dataset."""
-    return {
+def dataset_features(spec: TaskSpec, sim_state_size: int | None = None) -> dict[str, dict]:
+    """LeRobot ``features`` for a task's interventional dataset (with ``sim_state`` when its size is given)."""
+    features = {
         OBS_STATE: {"dtype": "float32", "shape": (len(spec.state_names),), "names": list(spec.state_names)},
         OBS_ENV_STATE: {"dtype": "float32", "shape": (len(spec.env_state_names),), "names": list(spec.env_state_names)},
         ACTION: {"dtype": "float32", "shape": (len(spec.action_names),), "names": list(spec.action_names)},
@@ -105,18 +115,26 @@ def dataset_features(spec: TaskSpec) -> dict[str, dict]:
         REWARD: {"dtype": "float32", "shape": (1,), "names": None},
         DONE: {"dtype": "bool", "shape": (1,), "names": None},
     }
+    if sim_state_size is not None:
+        features[SIM_STATE] = {"dtype": "float64", "shape": (int(sim_state_size),), "names": None}
+    return features
 
 
-def episode_frames(episode: Episode, spec: TaskSpec) -> Iterator[dict]:
-    """LeRobot ``add_frame`` dicts for one validated episode."""
+def episode_frames(episode: Episode, spec: TaskSpec, with_sim_state: bool = False) -> Iterator[dict]:
+    """LeRobot ``add_frame`` dicts for one validated episode (``with_sim_state``: the dataset has that column)."""
     episode.validate(spec)
+    if with_sim_state and episode.sim_state is None:
+        raise DatasetSchemaError(
+            f"a {episode.kind} episode (seed {episode.seed}) has no simulator state but the dataset records one: "
+            "every episode of a dataset must come from a simulator, or none"
+        )
     corruption = np.asarray(episode.corruption, dtype=np.float32)
     seed = np.array([episode.seed], dtype=np.int64)
     kind = np.array([EpisodeKind.ALL.index(episode.kind)], dtype=np.int64)
     success = np.array([episode.success], dtype=bool)
     last = episode.length - 1
     for t in range(episode.length):
-        yield {
+        frame = {
             OBS_STATE: episode.state[t].astype(np.float32),
             OBS_ENV_STATE: episode.env_state[t].astype(np.float32),
             ACTION: episode.action[t].astype(np.float32),
@@ -132,3 +150,6 @@ def episode_frames(episode: Episode, spec: TaskSpec) -> Iterator[dict]:
             DONE: np.array([t == last]),
             "task": spec.instruction,
         }
+        if with_sim_state:
+            frame[SIM_STATE] = episode.sim_state[t].astype(np.float64)
+        yield frame

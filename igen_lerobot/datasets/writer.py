@@ -8,6 +8,7 @@ and running the same command again resumes from it.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import logging
 import shlex
@@ -21,7 +22,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from igen_lerobot.core.episode import Episode
-from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.schema import SCHEMA_VERSION, dataset_features, episode_frames
 from igen_lerobot.datasets.spool import EpisodeSpool
@@ -153,7 +154,18 @@ def write_lerobot_dataset(
     build_dir = Path(build_dir)
     if build_dir.exists():
         shutil.rmtree(build_dir)
-    features = dataset_features(spec)
+    episodes = iter(episodes)
+    first = next(episodes, None)
+    if first is None:
+        raise ConfigError(f"no episode to write to {build_dir}")
+    episodes = itertools.chain([first], episodes)
+    sim_size = None if first.sim_state is None else int(first.sim_state.shape[1])
+    metadata = dict(metadata)
+    if sim_size is not None:
+        metadata["sim_state_layout"] = _checked_layout(spec, metadata.get("sim_state_layout"), sim_size)
+    else:
+        metadata.pop("sim_state_layout", None)
+    features = dataset_features(spec, sim_size)
     dataset = LeRobotDataset.create(
         repo_id=repo_id, fps=spec.fps, features=features, root=build_dir, robot_type=spec.robot_type, use_videos=False
     )
@@ -162,7 +174,7 @@ def write_lerobot_dataset(
     skip = _image_embedding_skipped(features) if fast_write else contextlib.nullcontext()
     with skip:
         for episode in tqdm(episodes, total=total, desc=desc, unit="ep"):
-            for frame in episode_frames(episode, spec):
+            for frame in episode_frames(episode, spec, with_sim_state=sim_size is not None):
                 dataset.add_frame(frame)
             dataset.save_episode()
             frames += episode.length
@@ -178,3 +190,25 @@ def write_lerobot_dataset(
     meta["episode_kinds"] = kinds
     (build_dir / IGEN_META_FILE).write_text(json.dumps(meta, indent=2, default=str))
     return frames, kinds
+
+
+def task_sim_state_layout(spec: TaskSpec) -> dict | None:
+    """The layout of the task's simulator state, from the installed task (None: it has no simulator)."""
+    from igen_lerobot.core.env_config import task_config_class
+
+    env = task_config_class(spec.name)().make_task_env()
+    try:
+        return env.sim_state_layout()
+    finally:
+        env.close()
+
+
+def _checked_layout(spec: TaskSpec, layout: dict | None, size: int) -> dict:
+    """The layout recorded with a dataset whose ``sim_state`` has ``size`` values per frame."""
+    layout = layout or task_sim_state_layout(spec)
+    if layout is None or int(layout.get("size", -1)) != size:
+        raise DatasetSchemaError(
+            f"the episodes carry {size} simulator-state values per frame, but task {spec.name!r} as installed "
+            f"records {None if layout is None else layout.get('size')}: they come from another version of the task"
+        )
+    return layout

@@ -144,6 +144,17 @@ class PandaArm:
         self.goal_pos = self.data.site_xpos[self.site].copy()
         self.goal_rot = self.home_rot.copy()
 
+    CONTROLLER_STATE = ("gripper_level", *(f"goal_pos.{a}" for a in "xyz"), *(f"goal_rot.{i}" for i in range(9)))
+
+    def controller_state(self) -> np.ndarray:
+        """What the next control period depends on besides the physics: gripper level and goal pose."""
+        return np.concatenate([[self._gripper_level], self.goal_pos, self.goal_rot.reshape(-1)])
+
+    def restore_controller_state(self, state: np.ndarray) -> None:
+        self._gripper_level = float(state[0])
+        self.goal_pos = np.array(state[1:4], dtype=float)
+        self.goal_rot = np.ascontiguousarray(np.reshape(state[4:13], (3, 3)), dtype=float)
+
     def eef_pose(self) -> np.ndarray:
         pose = np.eye(4)
         pose[:3, :3] = self.data.site_xmat[self.site].reshape(3, 3)

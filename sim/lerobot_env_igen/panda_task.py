@@ -231,6 +231,55 @@ class PandaTaskEnv(TaskEnv):
     def reveal_mode(self) -> Reveal:
         return self.spec.reveal
 
+    # ------------------------------------------------------------------ simulator state
+    # MuJoCo's physics (time, qpos, qvel, act), the controls and the solver's warm start: with these
+    # a restored simulation renders, and steps on, exactly as the recorded one did
+    MJ_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS | mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_WARMSTART
+
+    @property
+    def _fixed_bodies(self) -> list[str]:
+        """Objects placed through ``model.body_pos`` at reset (outside MuJoCo's state)."""
+        return [name for name, body in self.bodies.items() if self.model.body_jntnum[body] == 0]
+
+    def sim_state(self) -> np.ndarray:
+        mj = np.empty(mujoco.mj_stateSize(self.model, self.MJ_STATE))
+        mujoco.mj_getState(self.model, self.data, mj, self.MJ_STATE)
+        fixed = [
+            np.concatenate([self.model.body_pos[self.bodies[n]], self.model.body_quat[self.bodies[n]]])
+            for n in self._fixed_bodies
+        ]
+        return np.concatenate([mj, *fixed, self.arm.controller_state()])
+
+    def sim_state_layout(self) -> dict:
+        model = self.model
+        return {
+            "mujoco_state_spec": int(self.MJ_STATE),
+            "mujoco_state_size": int(mujoco.mj_stateSize(model, self.MJ_STATE)),
+            "fixed_bodies": [f"{name}.{k}" for name in self._fixed_bodies for k in ("pos", "quat_wxyz")],
+            "controller": list(self.arm.CONTROLLER_STATE),
+            "size": int(self.sim_state().shape[0]),
+            "model": {"nq": int(model.nq), "nv": int(model.nv), "nu": int(model.nu), "nbody": int(model.nbody)},
+        }
+
+    def restore_sim_state(self, state: np.ndarray) -> None:
+        state = np.asarray(state, dtype=float).reshape(-1)
+        size = mujoco.mj_stateSize(self.model, self.MJ_STATE)
+        expected = size + 7 * len(self._fixed_bodies) + len(self.arm.CONTROLLER_STATE)
+        if state.shape[0] != expected:
+            raise ValueError(
+                f"a {self.spec.name} simulator state has {expected} values, got {state.shape[0]}: "
+                "it was recorded by another task or another version of its scene"
+            )
+        mujoco.mj_setState(self.model, self.data, state[:size], self.MJ_STATE)
+        at = size
+        for name in self._fixed_bodies:
+            body = self.bodies[name]
+            self.model.body_pos[body] = state[at : at + 3]
+            self.model.body_quat[body] = state[at + 3 : at + 7]
+            at += 7
+        self.arm.restore_controller_state(state[at:])
+        mujoco.mj_forward(self.model, self.data)
+
     # ------------------------------------------------------------------ rendering
     def render(self, camera: str = "frontview", width: int = 256, height: int = 256) -> np.ndarray:
         """RGB image (H, W, 3) uint8 from one of the scene's cameras (needs MUJOCO_GL=egl headless)."""
