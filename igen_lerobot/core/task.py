@@ -105,6 +105,8 @@ class TaskSpec:
     state_names: tuple[str, ...] = (*EEF_STATE_NAMES, "gripper.width")
     env_state_names: tuple[str, ...] = ()  # () = the standard layout (see the module docstring)
     boxes: tuple[ObjectBox, ...] = ()  # how to draw each object (default: a 5 cm cube)
+    # cameras the task renders (a simulated task has at least a fixed third-person "agentview" and a "wrist")
+    cameras: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "reveal", Reveal(self.reveal))
@@ -300,6 +302,10 @@ class TaskEnv(abc.ABC):
     def restore_sim_state(self, state: np.ndarray) -> None:
         """Put the simulator back into a recorded :meth:`sim_state`."""
         raise NotImplementedError(f"task {self.spec.name!r} has no simulator state to restore")
+
+    def render(self, camera: str, width: int, height: int) -> np.ndarray:
+        """(height, width, 3) uint8 RGB from one of ``spec.cameras``."""
+        raise NotImplementedError(f"task {self.spec.name!r} renders no cameras")
 
     def close(self) -> None:  # noqa: B027 - optional hook, most envs hold no resources.
         """Release simulator or hardware resources."""

@@ -22,6 +22,7 @@ from igen_lerobot.core.belief import ObjectBelief, Reveal
 from igen_lerobot.core.error_models import ErrorModel
 from igen_lerobot.core.observation import observation
 from igen_lerobot.core.task import StepInfo, TaskEnv, TaskSpec
+from lerobot_env_igen.cameras import PANDA_CAMERAS
 from lerobot_env_igen.panda import TOP_DOWN_ROT, ContactEvent, PandaArm
 from lerobot_env_igen.scene import build_panda_table_scene
 
@@ -282,7 +283,9 @@ class PandaTaskEnv(TaskEnv):
 
     # ------------------------------------------------------------------ rendering
     def render(self, camera: str = "frontview", width: int = 256, height: int = 256) -> np.ndarray:
-        """RGB image (H, W, 3) uint8 from one of the scene's cameras (needs MUJOCO_GL=egl headless)."""
+        """RGB image (H, W, 3) uint8 from one of the task's cameras (needs MUJOCO_GL=egl headless)."""
+        if camera not in PANDA_CAMERAS:
+            raise ValueError(f"task {self.spec.name!r} has no camera {camera!r}; its cameras: {list(PANDA_CAMERAS)}")
         if self._renderer is None or (self._renderer.width, self._renderer.height) != (width, height):
             if self._renderer is not None:
                 self._renderer.close()
@@ -293,7 +296,7 @@ class PandaTaskEnv(TaskEnv):
                     "MuJoCo could not create an OpenGL context for rendering. On a headless machine set "
                     "MUJOCO_GL=egl before starting Python (and install libegl1/libgl1-mesa-dri: scripts/setup.sh)."
                 ) from err
-        self._renderer.update_scene(self.data, camera=camera, scene_option=self._render_option)
+        self._renderer.update_scene(self.data, camera=PANDA_CAMERAS[camera], scene_option=self._render_option)
         return self._renderer.render()
 
     def close(self) -> None:

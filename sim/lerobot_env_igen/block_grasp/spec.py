@@ -2,6 +2,7 @@
 
 from igen_lerobot.core.error_models import BoxNoise
 from igen_lerobot.core.task import SubtaskSpec, TaskSpec
+from lerobot_env_igen.cameras import PANDA_CAMERAS
 
 CUBE_HALF = 0.025  # [m] half side of the 5 cm cube
 LIFT_SUCCESS = 0.04  # [m] the cube must rise this much above its resting height
@@ -20,6 +21,7 @@ SPEC = TaskSpec(
     corrupted_object="cube",
     corruption_names=("cube.dx", "cube.dy", "cube.dz"),
     reveal_contact=("gripper", "cube"),
+    cameras=tuple(PANDA_CAMERAS),
 )
 
 

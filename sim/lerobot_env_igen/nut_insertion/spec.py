@@ -3,6 +3,7 @@
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import BoxNoise
 from igen_lerobot.core.task import ObjectBox, SubtaskSpec, TaskSpec
+from lerobot_env_igen.cameras import PANDA_CAMERAS
 
 # robosuite's square nut (models/assets/objects/square-nut.xml): a square ring 8.75 cm outside with
 # a 4.55 cm hole, 2 cm thick, and a handle box centred 5.4 cm out along the nut's x axis.
@@ -32,6 +33,7 @@ SPEC = TaskSpec(
         ObjectBox("nut", half_size=(0.0615, 0.04375, NUT_HALF_THICKNESS), center=(0.0178, 0.0, 0.0)),
         ObjectBox("peg", half_size=PEG_HALF),
     ),
+    cameras=tuple(PANDA_CAMERAS),
 )
 
 
