@@ -21,6 +21,7 @@ from lerobot.envs.configs import EnvConfig
 from igen_lerobot.core.actions import ActionSpace
 from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
+from igen_lerobot.core.cameras import CameraConfig, image_key
 from igen_lerobot.core.error_models import ErrorModel, NoNoise
 from igen_lerobot.core.exceptions import ConfigError, UnknownTaskError
 from igen_lerobot.core.paper import PaperTable
@@ -36,6 +37,7 @@ __all__ = [
 ]
 
 GYM_ENTRY_POINT = "igen_lerobot.core.gym_env:TaskGymEnv"
+OBS_TYPES = ("state", "pixels_state")
 
 
 @dataclass
@@ -56,6 +58,11 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
     episode_length: int = 200
     render_camera: str = "frontview"
     render_size: int = 256
+    # state: observation.state + observation.environment_state; pixels_state: those plus one image per
+    # camera (observation.images.<camera>), rendered as igen-render renders datasets
+    obs_type: str = "state"
+    cameras: list[str] = field(default_factory=lambda: ["agentview", "wrist"])  # with obs_type=pixels_state
+    image_size: int = 128  # [px] with obs_type=pixels_state
 
     def __post_init__(self) -> None:
         spec = self.base_spec
@@ -75,7 +82,17 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
                 "(its mistake is not a contact); use --env.reveal=none"
             )
         self._check_error_model()
-        self.features, self.features_map = lerobot_features(self.task_spec)
+        if self.obs_type not in OBS_TYPES:
+            raise ConfigError(f"env.obs_type={self.obs_type!r} is not one of {list(OBS_TYPES)}")
+        if self.image_cameras.cameras:
+            self.image_cameras.check(spec, flag="--env")
+        self.features, self.features_map = lerobot_features(self.task_spec, self.image_cameras)
+
+    @property
+    def image_cameras(self) -> CameraConfig:
+        """The cameras this env observes (none with ``obs_type=state``)."""
+        cameras = list(self.cameras) if self.obs_type == "pixels_state" else []
+        return CameraConfig(cameras, self.image_size)
 
     def _check_error_model(self) -> None:
         spec = self.base_spec
@@ -141,14 +158,19 @@ def _names_of(cls: type) -> tuple[str, ...] | None:
         return None
 
 
-def lerobot_features(spec: TaskSpec) -> tuple[dict[str, PolicyFeature], dict[str, str]]:
-    """LeRobot's env ``features`` and ``features_map`` for a task, from its spec."""
+def lerobot_features(
+    spec: TaskSpec, cameras: CameraConfig | None = None
+) -> tuple[dict[str, PolicyFeature], dict[str, str]]:
+    """LeRobot's env ``features`` and ``features_map`` for a task, from its spec (and observed cameras)."""
     features = {
         ACTION: PolicyFeature(type=FeatureType.ACTION, shape=(len(spec.action_names),)),
         "agent_pos": PolicyFeature(type=FeatureType.STATE, shape=(len(spec.state_names),)),
         "environment_state": PolicyFeature(type=FeatureType.ENV, shape=(len(spec.env_state_names),)),
     }
     features_map = {ACTION: ACTION, "agent_pos": OBS_STATE, "environment_state": OBS_ENV_STATE}
+    for camera in cameras.cameras if cameras is not None else []:
+        features[f"pixels/{camera}"] = PolicyFeature(type=FeatureType.VISUAL, shape=(cameras.size, cameras.size, 3))
+        features_map[f"pixels/{camera}"] = image_key(camera)
     return features, features_map
 
 

@@ -1,7 +1,8 @@
 """Any :class:`~igen_lerobot.core.task.TaskEnv` as a gymnasium env that ``lerobot-eval`` can roll out.
 
-Observation keys follow LeRobot's env conventions: ``agent_pos`` becomes ``observation.state``
-and ``environment_state`` becomes ``observation.environment_state`` in LeRobot's preprocessing.
+Observation keys follow LeRobot's env conventions: ``agent_pos`` becomes ``observation.state``,
+``environment_state`` becomes ``observation.environment_state`` and, with ``obs_type=pixels_state``,
+``pixels/<camera>`` becomes ``observation.images.<camera>`` in LeRobot's preprocessing.
 ``info["is_success"]`` carries the task's success; an episode terminates on success.
 """
 
@@ -12,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import gymnasium as gym
 import numpy as np
 
+from igen_lerobot.core.cameras import render_images
 from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE
 
 if TYPE_CHECKING:
@@ -39,21 +41,28 @@ class TaskGymEnv(gym.Env):
         self.task_description = spec.instruction
         self.task = spec.name
         inf = np.float32(np.inf)
-        self.observation_space = gym.spaces.Dict(
-            {
-                "agent_pos": gym.spaces.Box(-inf, inf, (len(spec.state_names),), np.float32),
-                "environment_state": gym.spaces.Box(-inf, inf, (len(spec.env_state_names),), np.float32),
-            }
-        )
+        spaces = {
+            "agent_pos": gym.spaces.Box(-inf, inf, (len(spec.state_names),), np.float32),
+            "environment_state": gym.spaces.Box(-inf, inf, (len(spec.env_state_names),), np.float32),
+        }
+        self._cameras = config.image_cameras
+        if self._cameras.cameras:
+            size = self._cameras.size
+            spaces["pixels"] = gym.spaces.Dict(
+                {c: gym.spaces.Box(0, 255, (size, size, 3), np.uint8) for c in self._cameras.cameras}
+            )
+        self.observation_space = gym.spaces.Dict(spaces)
         low, high = self.task_env.action_bounds()
         self.action_space = gym.spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
 
-    @staticmethod
-    def _to_gym(obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        return {
+    def _to_gym(self, obs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        out = {
             "agent_pos": obs[OBS_STATE].astype(np.float32),
             "environment_state": obs[OBS_ENV_STATE].astype(np.float32),
         }
+        if self._cameras.cameras:  # the same pixels igen-render writes into datasets
+            out["pixels"] = render_images(self.task_env, self._cameras.cameras, self._cameras.size)
+        return out
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
