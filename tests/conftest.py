@@ -99,3 +99,15 @@ def bc_rnn_checkpoint(source_demos, tmp_path_factory):
 
     cfg = TrainConfig(policy_type="bc_rnn", steps=3, batch_size=8, num_workers=0)
     return lerobot_train(cfg, source_demos, "local/block_grasp_demos", tmp_path_factory.mktemp("train") / "bc_rnn")
+
+
+# Tests that run a robot or a person in wall-clock time (franky-sim's 1 kHz arm, LeRobot's
+# record/replay/rollout loops, key presses on Xvfb): they run on their own, after the rest, so a
+# parallel test never steals the cycles their timing depends on (see the Makefile's test target).
+REALTIME_MODULES = {"test_franky_backend.py", "test_lerobot_robot.py", "test_teleop.py"}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.path.name in REALTIME_MODULES:
+            item.add_marker(pytest.mark.realtime)

@@ -210,3 +210,33 @@ def test_act_trains_on_a_rendered_dataset_and_lerobot_eval_runs_it_on_the_env_ca
     assert evaluation.returncode == 0, evaluation.stderr[-3000:]
     info = json.loads((tmp_path / "eval/eval_info.json").read_text())
     assert info["overall"]["n_episodes"] == 1
+
+
+def test_igen_collect_renders_cameras_into_the_dataset_it_writes(tmp_path, demos):
+    root = tmp_path / "collected"
+    common = ["--env.type=block_grasp", "--mode=demos", "--num_episodes=1", f"--dataset.root={root}"]
+    result = subprocess.run(
+        [str(BIN / "igen-collect"), *common, "--render.cameras=[wrist]", "--render.size=48"],
+        env=ENV,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert result.returncode == 0, "\n".join(line for line in result.stderr.splitlines() if "Svt" not in line)[-3000:]
+    dataset = LeRobotDataset("local/collected", root=root)
+    assert tuple(dataset.meta.features[image_key("wrist")]["shape"]) == (48, 48, 3)
+    assert "complementary_info.sim_state" in dataset.meta.features  # still renderable with other cameras
+    assert dataset[0][image_key("wrist")].shape == (3, 48, 48)
+    meta = json.loads((root / "meta" / "igen.json").read_text())
+    assert meta["created_by"] == "igen-collect" and meta["cameras"] == {"wrist": {"size": 48}}
+    assert not root.with_name("collected.partial").exists()
+    # a camera the task lacks stops both commands before any work, naming the task's cameras
+    for command, args in (
+        ("igen-collect", [*common[:-1], f"--dataset.root={tmp_path / 'x'}"]),
+        ("igen-generate", ["--task=block_grasp", f"--source.root={demos}", f"--dataset.root={tmp_path / 'x'}"]),
+    ):
+        bad = subprocess.run(
+            [str(BIN / command), *args, "--render.cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=600
+        )
+        assert bad.returncode == 2 and "has no camera 'top'; its cameras:" in bad.stderr, bad.stderr[-2000:]
+        assert not (tmp_path / "x").exists() and not (tmp_path / "x.partial").exists()

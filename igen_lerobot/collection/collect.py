@@ -40,6 +40,7 @@ def collect(cfg: CollectConfig) -> None:
         logger.info("demos are recorded on true poses: overriding env.corruption with none")
         env_cfg.corruption = NoNoise()
     spec = env_cfg.task_spec
+    cfg.render.check(spec)  # a camera the task lacks fails here, before anything is recorded
     repo_id, root = cfg.dataset.resolve(f"{spec.name}_{cfg.mode}")
     builder = DatasetBuilder(root, repo_id, spec, overwrite=cfg.dataset.overwrite)
     spool = builder.spool
@@ -102,6 +103,7 @@ def collect(cfg: CollectConfig) -> None:
             "env": draccus.encode(env_cfg),
             "rejections": spool.rejection_reasons(),
         },
+        cameras=cfg.render,
     )
     print(f"Wrote {summary.episodes} {cfg.mode} episodes ({summary.frames} frames) to {summary.root}")
     cfg.dataset.publish(summary.root)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from lerobot.envs.configs import EnvConfig
 from lerobot.teleoperators.config import TeleoperatorConfig
 
+from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
@@ -36,6 +37,8 @@ class CollectConfig:
     teleop_gate: str = "auto"  # "motion" (held keys), "events" (device intervention button), "auto"
     policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # the base policy the operator corrects
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
+    # --render.cameras='[agentview,wrist]' --render.size=128: the dataset also carries these camera streams
+    render: CameraConfig = field(default_factory=CameraConfig)
     rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log each episode
 
     def __post_init__(self) -> None:

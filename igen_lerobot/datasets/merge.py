@@ -64,7 +64,7 @@ def merge_datasets(
     output_root = Path(output_root)
     if output_root.exists() and not overwrite:
         raise ConfigError(f"{output_root} exists; pick another output or pass overwrite")
-    metas, frames, outdated, with_sim = [], [], [], []
+    metas, frames, outdated, with_sim, camera_sets = [], [], [], [], []
     for root in roots:
         info = read_igen_meta(root, "--inputs")
         if info.task != spec.name:
@@ -83,6 +83,13 @@ def merge_datasets(
         frames.append(lerobot_meta.total_frames)
         outdated.append(not all(key in lerobot_meta.features for key in RL_COLUMNS))
         with_sim.append(SIM_STATE in lerobot_meta.features)
+        camera_sets.append({k: v["shape"] for k, v in lerobot_meta.features.items() if v["dtype"] == "video"})
+    if any(c != camera_sets[0] for c in camera_sets):
+        streams = dict(zip(map(str, roots), camera_sets, strict=True))
+        raise ConfigError(
+            f"cannot merge datasets with different camera streams ({streams}): "
+            "render them all with the same cameras and size first (igen-render --cameras=... --size=...)"
+        )
     # simulator states survive a merge only if every part has them (LeRobot aggregates equal features)
     keep_sim = all(with_sim)
     if any(with_sim) and not keep_sim:

@@ -203,7 +203,7 @@ def render_dataset(
     rendered = {
         **meta,
         "cameras": {c: {"size": int(cameras.size)} for c in cameras.cameras},
-        "rendered_from": {"root": str(root), "command": running_command()},
+        "rendered_from": {"root": str(root) if not root.is_relative_to(work) else None, "command": running_command()},
     }
     (build / IGEN_META_FILE).write_text(json.dumps(rendered, indent=2, default=str))
     if output_root.exists():

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.episode import Episode
 from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError
 from igen_lerobot.core.task import TaskSpec
@@ -95,19 +96,37 @@ class DatasetBuilder:
             self.work_dir.mkdir(parents=True, exist_ok=True)
             marker.write_text(json.dumps({"task": self.spec.name}))
 
-    def finalize(self, num_episodes: int | None, metadata: dict, fast_write: bool = True) -> BuildSummary:
-        """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at ``root``."""
+    def finalize(
+        self,
+        num_episodes: int | None,
+        metadata: dict,
+        fast_write: bool = True,
+        cameras: CameraConfig | None = None,
+        render_workers: int = 1,
+    ) -> BuildSummary:
+        """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at ``root``.
+
+        With ``cameras``, the frames are then rendered from their simulator states (``igen-render``'s
+        resumable path, into the same work folder) and the dataset at ``root`` carries the images.
+        """
         start = time.perf_counter()
         kept = self.spool.kept_attempts()
         count = len(kept) if num_episodes is None else min(num_episodes, len(kept))
         if count == 0:
             raise ConfigError(f"no episode was kept in {self.spool.directory}; nothing to write")
-        build_dir = self.work_dir / "lerobot"
+        rendering = cameras is not None and bool(cameras.cameras)
+        build_dir = self.work_dir / ("state_only" if rendering else "lerobot")
         episodes = (episode for _, episode in self.spool.iter_kept(count))
         frames, _ = write_lerobot_dataset(
             build_dir, self.repo_id, self.spec, episodes, count, metadata, fast_write=fast_write
         )
-        self._publish(build_dir)
+        if rendering:
+            from igen_lerobot.datasets.render import render_dataset
+
+            # renders into <root>.partial/chunks, publishes <root> and removes the work folder
+            render_dataset(build_dir, self.root, self.repo_id, cameras, num_workers=render_workers, overwrite=True)
+        else:
+            self._publish(build_dir)
         seconds = time.perf_counter() - start
         logger.info("wrote %d episodes (%d frames) to %s in %.1f s", count, frames, self.root, seconds)
         return BuildSummary(self.root, count, frames, seconds)

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 from lerobot.envs.configs import EnvConfig
 
+from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.env_config import resolve_task_env
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
@@ -47,6 +48,8 @@ class GenerateConfig:
     igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
     merge_with: str | None = None  # root of a base dataset to aggregate the generated episodes with
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
+    # --render.cameras='[agentview,wrist]' --render.size=128: the dataset also carries these camera streams
+    render: CameraConfig = field(default_factory=CameraConfig)
     rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log kept episodes
 
     def __post_init__(self) -> None:

@@ -92,6 +92,7 @@ def generate(cfg: GenerateConfig) -> None:
         logger.info("MimicGen demonstrations observe true poses: overriding env.corruption with none")
         env_cfg = dataclasses.replace(env_cfg, corruption=NoNoise())
     spec = env_cfg.task_spec
+    cfg.render.check(spec)  # a camera the task lacks fails here, before any work
     source_root = Path(cfg.source.root)
     episodes = load_episodes(source_root, spec, repo_id=cfg.source.repo_id, flag="--source.root")
     actions = env_cfg.make_action_space()
@@ -156,6 +157,8 @@ def generate(cfg: GenerateConfig) -> None:
                 "dropped": builder.spool.rejection_reasons(),
             },
         },
+        cameras=cfg.render,
+        render_workers=cfg.workers,
     )
     print(f"Wrote {summary.episodes} {mode.value} episodes ({summary.frames} frames) to {summary.root}")
     cfg.dataset.publish(summary.root)

@@ -56,6 +56,7 @@ class FrankyArmConfig(ArmBackendConfig):
     gripper_speed: float = 0.1  # [m/s]
     open_width: float = 0.08  # [m]
     gripper_timeout: float = 5.0  # [s] the longest a gripper command may take before the next is sent
+    settle_timeout: float = 3.0  # [s] the longest the move home waits for the last target's motion
     tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
 
     def make_driver(self) -> ArmDriver:
@@ -211,13 +212,38 @@ class FrankyArm(ArmDriver):
     def recover(self) -> None:
         self._call("error recovery", self.robot.recover_from_errors)
 
+    def _finish_last_motion(self) -> None:
+        """Let the last asynchronous target finish (bounded) and clear any error it left.
+
+        A motion's failure surfaces at the next command: the move home would inherit the last
+        target's error instead of starting from a still, error-free arm.
+        """
+        try:
+            self.robot.join_motion(self.config.settle_timeout)
+        except Exception as error:  # noqa: BLE001 - any franky error of the finished motion
+            failure = self._fail("the last target", error)
+            if isinstance(failure, ConnectionLostError):
+                raise failure from error
+            logger.warning("the last target before the move home ended with %s: %s", type(error).__name__, error)
+        self._call("error recovery", self.robot.recover_from_errors)
+
     def move_home(self) -> None:
         cfg = self.config
         T_home = np.eye(4)
         T_home[:3, :3] = np.asarray(TOP_DOWN_TCP) @ self._T_tcp_site[:3, :3]  # the site's top-down pose
         T_home[:3, 3] = cfg.home_position
         factor = self._franky.RelativeDynamicsFactor(cfg.home_velocity_factor, cfg.acceleration_factor, cfg.jerk_factor)
-        self._call("the move home", self.robot.move, self._motion(T_home, factor))
+        self._finish_last_motion()
+        try:
+            self._call("the move home", self.robot.move, self._motion(T_home, factor))
+        except ConnectionLostError:
+            raise
+        except DriverError as error:
+            # planned from an arm still pushing on something (a trial ending in contact) the move can
+            # fail (ruckig -101); once the arm has come to rest and errors are cleared it plans
+            logger.warning("%s; recovering and trying the move home once more", error)
+            self._finish_last_motion()
+            self._call("the move home", self.robot.move, self._motion(T_home, factor))
         self.set_gripper(False)
         if self._pending is not None:
             self._call("opening the gripper", self._pending.wait, 5.0)
