@@ -9,8 +9,11 @@ setup:
 demo: setup
 	@bash scripts/demo.sh
 
+# Two passes: everything but the wall-clock robot tests on both cores (pytest-xdist, one file per
+# worker), then the `realtime` ones alone so nothing steals the cycles their timing depends on.
 test: setup
-	@.venv/bin/python -m pytest
+	@.venv/bin/python -m pytest -n 2 --dist loadfile -m "not realtime"
+	@.venv/bin/python -m pytest -m realtime
 
 lint: setup
 	@.venv/bin/ruff check .

@@ -240,3 +240,39 @@ def test_igen_collect_renders_cameras_into_the_dataset_it_writes(tmp_path, demos
         )
         assert bad.returncode == 2 and "has no camera 'top'; its cameras:" in bad.stderr, bad.stderr[-2000:]
         assert not (tmp_path / "x").exists() and not (tmp_path / "x.partial").exists()
+
+
+def test_igen_viz_shows_the_camera_streams_next_to_the_path(rendered, tmp_path):
+    """Read back with Rerun's own reader: one JPEG per frame and camera, matching the dataset's frame."""
+    import io
+
+    from PIL import Image
+    from test_viz import column, read_rrd
+
+    from igen_lerobot.viz.replay import replay_dataset
+    from igen_lerobot.viz.rerun_log import RerunConfig
+
+    out = tmp_path / "rendered.rrd"
+    result = replay_dataset(rendered, RerunConfig(mode="save", path=str(out)), episodes=[0])
+    assert result["cameras"] == ["agentview", "wrist"]
+    chunks = read_rrd(out)
+    assert "/episodes/0/path" in chunks
+    dataset = LeRobotDataset("local/r", root=rendered, episodes=[0])
+    for camera in ("agentview", "wrist"):
+        blobs = column(chunks[f"/episodes/0/cameras/{camera}"], "EncodedImage:blob")
+        assert len(blobs) == len(dataset)
+        shown = np.asarray(Image.open(io.BytesIO(bytes(blobs[0][0])))).astype(np.float32)
+        stored = dataset[0][image_key(camera)].numpy().transpose(1, 2, 0) * 255
+        assert shown.shape == (SIZE, SIZE, 3) and np.abs(shown - stored).mean() < 4  # JPEG at quality 90
+
+
+def test_the_dataset_card_lists_the_cameras(rendered):
+    from igen_lerobot.datasets.card import card_fields
+    from igen_lerobot.datasets.reader import dataset_spec, read_igen_meta
+
+    info = json.loads((rendered / "meta" / "info.json").read_text())
+    body = card_fields(rendered, dataset_spec(rendered), info, read_igen_meta(rendered).meta)["dataset_description"]
+    assert (
+        f"**Cameras** (2): `observation.images.agentview` ({SIZE}x{SIZE} px, video), "
+        f"`observation.images.wrist` ({SIZE}x{SIZE} px, video), rendered from the recorded simulator states"
+    ) in body

@@ -130,6 +130,7 @@ def test_push_then_read_back_frame_by_frame_with_the_card_and_the_version_tag(hu
     for section in ("## Limitations", "## License", "```bibtex"):
         assert section in body
     assert "**privileged**" in body and "never be a policy input" in body
+    assert "**Cameras**: none (state-only data). Every frame carries its simulator state" in body
     assert "Made by `igen-collect`, mode `interventions`" in body and "scripted operator" in body
     assert "igen-collect --env.type=block_grasp --mode=interventions --num_episodes=3" in body  # the exact command
     assert "`complementary_info.true_object_pose`" in body and '"corruption"' in body  # the error model, verbatim

@@ -161,6 +161,7 @@ def card_fields(root: Path, spec: TaskSpec, info: dict, meta: dict, command: lis
         f"{_error_model(meta)}; it is revealed on {' – '.join(spec.reveal_contact or ('nothing',))} contact with "
         f"reveal mode `{reveal}`.",
         "- **Episodes per kind**: " + "; ".join(f"{k} {v} ({KIND_MEANING.get(k, k)})" for k, v in kinds.items()) + ".",
+        _cameras_line(info, meta),
         "",
         "## Columns beyond the policy's inputs",
         "",
@@ -198,3 +199,23 @@ def card_fields(root: Path, spec: TaskSpec, info: dict, meta: dict, command: lis
         "paper": PAPER_URL,
         "citation_bibtex": CITATIONS,
     }
+
+
+def _cameras_line(info: dict, meta: dict) -> str:
+    """The camera streams (LeRobot video features) and how to get others."""
+    prefix = "observation.images."
+    streams = {k[len(prefix) :]: v for k, v in (info.get("features") or {}).items() if k.startswith(prefix)}
+    renderable = "complementary_info.sim_state" in (info.get("features") or {})
+    rerender = (
+        " Every frame carries its simulator state, so `igen-render --dataset.root=... --cameras=... --size=...` "
+        "renders other cameras or sizes."
+        if renderable
+        else ""
+    )
+    if not streams:
+        return f"- **Cameras**: none (state-only data).{rerender}"
+    described = ", ".join(
+        f"`{prefix}{name}` ({'x'.join(str(d) for d in ft['shape'][:2])} px, {ft['dtype']})"
+        for name, ft in streams.items()
+    )
+    return f"- **Cameras** ({len(streams)}): {described}, rendered from the recorded simulator states.{rerender}"

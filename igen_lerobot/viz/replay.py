@@ -6,8 +6,10 @@ import logging
 import time
 from pathlib import Path
 
+import numpy as np
 from tqdm import tqdm
 
+from igen_lerobot.core.cameras import IMAGE_PREFIX, image_key
 from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 from igen_lerobot.viz.config_viz import VizConfig
 from igen_lerobot.viz.rerun_log import EpisodeLogger, RerunConfig
@@ -25,14 +27,41 @@ def replay_dataset(
     log = EpisodeLogger.open(rerun, spec, f"replay/{Path(root).name}")
     if log is None:
         raise ValueError("replaying needs --rerun.mode=save or spawn")
+    cameras = camera_features(Path(root))
     frames = 0
     try:
         for episode in tqdm(loaded, desc=f"replaying {Path(root).name}", unit="ep"):
-            log.log_episode_object(episode.extra["episode_index"], episode)
+            index = episode.extra["episode_index"]
+            log.log_episode_object(index, episode)
+            if cameras:
+                log.log_camera_streams(index, camera_frames(Path(root), repo_id, index, cameras))
             frames += episode.length
     finally:
         log.close()
-    return {"episodes": len(loaded), "frames": frames, "seconds": time.perf_counter() - start}
+    return {"episodes": len(loaded), "frames": frames, "seconds": time.perf_counter() - start, "cameras": cameras}
+
+
+def camera_features(root: Path) -> list[str]:
+    """The dataset's camera names (its ``observation.images.<camera>`` video or image features)."""
+    import json
+
+    features = json.loads((root / "meta" / "info.json").read_text())["features"]
+    prefix = f"{IMAGE_PREFIX}."
+    return [k[len(prefix) :] for k, v in features.items() if k.startswith(prefix) and v["dtype"] in ("video", "image")]
+
+
+def camera_frames(root: Path, repo_id: str | None, episode_index: int, cameras: list[str]) -> dict[str, np.ndarray]:
+    """(T, H, W, 3) uint8 frames per camera of one episode, decoded by LeRobot."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    dataset = LeRobotDataset(repo_id or f"local/{root.name}", root=root, episodes=[episode_index])
+    frames: dict[str, list[np.ndarray]] = {c: [] for c in cameras}
+    for i in range(len(dataset)):
+        item = dataset[i]
+        for camera in cameras:
+            chw = item[image_key(camera)].numpy()
+            frames[camera].append(np.clip(np.round(chw.transpose(1, 2, 0) * 255), 0, 255).astype(np.uint8))
+    return {c: np.stack(v) for c, v in frames.items()}
 
 
 def replay_command(cfg: VizConfig) -> dict:

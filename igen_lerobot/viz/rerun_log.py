@@ -153,6 +153,14 @@ class EpisodeLogger:
             )
         self.episodes += 1
 
+    def log_camera_streams(self, index: int | str, streams: dict[str, np.ndarray]) -> None:
+        """A dataset's camera frames ((T, H, W, 3) uint8 per camera) next to the episode's path, on ``frame``."""
+        rr, stream = self.rr, self.stream
+        for camera, frames in streams.items():
+            for t, image in enumerate(frames):
+                stream.set_time(FRAME, sequence=t)
+                stream.log(f"episodes/{index}/cameras/{camera}", rr.Image(image).compress(jpeg_quality=90))
+
     def _boxes(self, obj: str, poses: np.ndarray, color: tuple[int, int, int]):
         """Box columns of ``obj`` at ``poses`` (N, 7: position + quaternion xyzw), drawn with their rotation."""
         from scipy.spatial.transform import Rotation
