@@ -51,4 +51,19 @@ export UV_PYTHON_DOWNLOADS=never
 uv sync --locked --all-packages --all-extras --python "$python" --quiet
 # franky-sim (the FR3 simulator the franky backend is tested against) needs mujoco 4: its own env.
 uv sync --locked --project tools/franky_sim --python "$python" --quiet
+
+# Bytecode. Where PYTHONDONTWRITEBYTECODE is set (as on this project's CI machines) Python never
+# caches what it compiles, so every process -- each test's igen-*/lerobot-* subprocess -- compiles
+# torch, lerobot and the rest from source again (~8 s each). Compile the environments once per
+# lock, and our own packages on every run (only changed files are recompiled).
+for venv in .venv tools/franky_sim/.venv; do
+  stamp="$venv/.bytecode-$(cat uv.lock tools/franky_sim/uv.lock | sha1sum | cut -c1-12)"
+  if [ ! -e "$stamp" ]; then
+    echo "setup: compiling $venv to bytecode (once per lock)"
+    "$venv/bin/python" -m compileall -q -j 0 "$venv"/lib/python3.12/site-packages >/dev/null 2>&1 || true
+    rm -f "$venv"/.bytecode-*
+    touch "$stamp"
+  fi
+done
+.venv/bin/python -m compileall -q -j 0 igen_lerobot sim hardware plugins tests tools/franky_sim/serve.py >/dev/null 2>&1 || true
 echo "setup: environment ready in .venv ($("$python" --version), $(uv --version))"

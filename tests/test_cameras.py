@@ -211,13 +211,37 @@ def test_act_trains_on_a_rendered_dataset_and_lerobot_eval_runs_it_on_the_env_ca
     info = json.loads((tmp_path / "eval/eval_info.json").read_text())
     assert info["overall"]["n_episodes"] == 1
 
+    # igen-eval: the same env flags; without the cameras it says which flags the checkpoint needs
+    igen_eval = [
+        str(BIN / "igen-eval"),
+        "--env.type=block_grasp",
+        f"--policy.path={checkpoint}",
+        "--env.episode_length=5",
+        "--n_trials=1",
+    ]
+    out = tmp_path / "igen_eval.json"
+    ours = subprocess.run(
+        [*igen_eval, "--env.obs_type=pixels_state", f"--env.image_size={SIZE}", f"--output={out}"],
+        env=ENV,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert ours.returncode == 0, ours.stderr[-3000:]
+    assert json.loads(out.read_text())["best"]["trials"] == 1
+    state_only = subprocess.run(igen_eval, env=ENV, capture_output=True, text=True, timeout=600)
+    assert state_only.returncode == 2, state_only.stderr[-3000:]
+    fix = f"--env.obs_type=pixels_state --env.cameras='[agentview,wrist]' --env.image_size={SIZE}"
+    assert fix in state_only.stderr
+
 
 def test_igen_collect_renders_cameras_into_the_dataset_it_writes(tmp_path, demos):
     root = tmp_path / "collected"
     common = ["--env.type=block_grasp", "--mode=demos", "--num_episodes=1", f"--dataset.root={root}"]
+    headless_by_default = {k: v for k, v in ENV.items() if k != "MUJOCO_GL"}
     result = subprocess.run(
         [str(BIN / "igen-collect"), *common, "--render.cameras=[wrist]", "--render.size=48"],
-        env=ENV,
+        env=headless_by_default,
         capture_output=True,
         text=True,
         timeout=600,

@@ -201,3 +201,32 @@ def test_a_recorded_simulator_state_restores_the_frame_exactly(config):
         other.restore_sim_state(state[:-1])
     other.close()
     env.close()
+
+
+def test_a_simulated_task_renders_a_third_person_and_a_wrist_camera(config):
+    """Every task with a simulator has ``agentview`` and ``wrist`` (what vision policies train on):
+    non-blank 32 px images that change when the hand moves; a task without one renders nothing."""
+    from igen_lerobot.core.cameras import CameraConfig, render_images
+    from igen_lerobot.core.exceptions import ConfigError
+
+    spec, env = config.task_spec, config.make_task_env()
+    if env.sim_state() is None:
+        assert spec.cameras == ()
+        with pytest.raises(NotImplementedError, match="renders no cameras"):
+            env.render("agentview", 32, 32)
+        with pytest.raises(ConfigError, match="renders no cameras"):
+            CameraConfig(["agentview"], 32).check(spec)
+        return
+    assert {"agentview", "wrist"} <= set(spec.cameras)
+    env.reset(episode_seed(4, 0))
+    before = render_images(env, list(spec.cameras), 32)
+    for name, image in before.items():
+        assert image.shape == (32, 32, 3) and image.dtype == np.uint8 and image.std() > 5, name
+    operator = config.make_scripted_operator()
+    operator.reset(env)
+    for _ in range(10):
+        env.step(operator.act(env))
+    after = render_images(env, ["agentview", "wrist"], 32)
+    for name in ("agentview", "wrist"):
+        assert np.abs(after[name].astype(int) - before[name]).mean() > 0.5, name
+    env.close()

@@ -120,7 +120,9 @@ def render_chunk(job: RenderJob) -> int:
                 for camera, image in images.items():
                     frame[image_key(camera)] = image
                 dataset.add_frame(frame)
-            dataset.save_episode()
+            # chunks are the parallel unit: no process pool per episode for its cameras (that pool
+            # costs a Python start per camera and episode, more than encoding a small video)
+            dataset.save_episode(parallel_encoding=False)
             frames += episode.length
         dataset.finalize()
     finally:

@@ -59,6 +59,7 @@ def run_eval(cfg: EvalConfig) -> dict:
                 env_cfg.episode_length,
                 on_trial=on_trial,
                 record_trials=viz is not None,
+                cameras=env_cfg.image_cameras,
             )
             result.step = step
             results.append(result)

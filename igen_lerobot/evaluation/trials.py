@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, field
 from tqdm import tqdm
 
 from igen_lerobot.core.agents import Policy
+from igen_lerobot.core.cameras import CameraConfig, image_key, render_images
 from igen_lerobot.core.episode import Episode
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.recorder import EpisodeRecorder
@@ -56,10 +57,25 @@ class EvalResult:
 
 
 def rollout(
-    env: TaskEnv, policy: Policy, seed: int, max_steps: int, recorder: EpisodeRecorder | None = None
+    env: TaskEnv,
+    policy: Policy,
+    seed: int,
+    max_steps: int,
+    recorder: EpisodeRecorder | None = None,
+    cameras: CameraConfig | None = None,
 ) -> tuple[bool, int]:
-    """One closed-loop episode; success ends it early, as in ``lerobot-eval``. ``recorder`` keeps the frames."""
-    obs = env.reset(seed)
+    """One closed-loop episode; success ends it early, as in ``lerobot-eval``. ``recorder`` keeps the frames.
+
+    With ``cameras`` the policy also sees ``observation.images.<camera>``, rendered as the LeRobot env does.
+    """
+
+    def observed(obs: dict) -> dict:
+        if cameras is None or not cameras.cameras:
+            return obs
+        images = render_images(env, cameras.cameras, cameras.size)
+        return {**obs, **{image_key(c): image for c, image in images.items()}}
+
+    obs = observed(env.reset(seed))
     policy.reset()
     for step in range(1, max_steps + 1):
         action = policy.act(obs)
@@ -67,7 +83,7 @@ def rollout(
             recorder.record(obs, action, FrameSource.POLICY, flagged=False)
         if env.step(action).success:
             return True, step
-        obs = env.observe()
+        obs = observed(env.observe())
     return False, max_steps
 
 
@@ -81,6 +97,7 @@ def evaluate(
     progress: bool = True,
     on_trial: Callable[[int, bool, int, Episode | None], None] | None = None,
     record_trials: bool = False,
+    cameras: CameraConfig | None = None,
 ) -> EvalResult:
     """Roll ``policy`` out for ``trials`` seeded trials.
 
@@ -95,7 +112,7 @@ def evaluate(
         for i in range(trials):
             recorder = EpisodeRecorder(env) if record_trials else None
             trial_seed = episode_seed(seed, i)
-            success, n = rollout(env, policy, trial_seed, max_steps, recorder)
+            success, n = rollout(env, policy, trial_seed, max_steps, recorder, cameras)
             outcomes.append(success)
             steps.append(n)
             if on_trial is not None:

@@ -6,15 +6,12 @@ Examples::
     igen-render --dataset.root=outputs/datasets/igen --cameras='[agentview,wrist]' --size=128 --num_workers=2
 
 The input is never modified; an interrupted run resumes from ``<output>.partial/`` when run again.
+Headless by default (``MUJOCO_GL=egl``, see ``igen_lerobot/scripts/__init__.py``).
 """
 
-import os
-
-os.environ.setdefault("MUJOCO_GL", "egl")  # headless by default (software rendering without a GPU)
-
-from igen_lerobot.datasets.config_render import RenderConfig  # noqa: E402
-from igen_lerobot.datasets.render import run_render  # noqa: E402
-from igen_lerobot.scripts.cli import run_cli  # noqa: E402
+from igen_lerobot.datasets.config_render import RenderConfig
+from igen_lerobot.datasets.render import run_render
+from igen_lerobot.scripts.cli import run_cli
 
 
 def main() -> None:

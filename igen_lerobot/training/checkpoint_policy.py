@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from igen_lerobot.core.cameras import IMAGE_PREFIX, CameraConfig, image_key
 from igen_lerobot.core.exceptions import ConfigError, TaskMismatchError
 from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskSpec
 
@@ -20,15 +21,26 @@ logger = logging.getLogger(__name__)
 FIX = "train a policy on a dataset of this task (and reveal mode), or run the task the checkpoint was trained on"
 
 
-def check_policy_features(input_features: dict, output_features: dict, spec: TaskSpec, where: str) -> None:
-    """The checkpoint's inputs/outputs are exactly what the task provides, or a clear error."""
+def check_policy_features(
+    input_features: dict, output_features: dict, spec: TaskSpec, where: str, cameras: CameraConfig | None = None
+) -> None:
+    """The checkpoint's inputs/outputs are exactly what the task (with ``cameras`` observed) provides."""
     provided = {OBS_STATE: (len(spec.state_names),), OBS_ENV_STATE: (len(spec.env_state_names),)}
+    for camera in cameras.cameras if cameras is not None else []:
+        provided[image_key(camera)] = (3, cameras.size, cameras.size)  # LeRobot's policies see images CHW
     for key, feature in input_features.items():
         shape = tuple(feature.shape)
         if key not in provided:
+            hint = ""
+            if key.startswith(f"{IMAGE_PREFIX}.") and len(shape) == 3:
+                wanted = [k[len(IMAGE_PREFIX) + 1 :] for k in input_features if k.startswith(f"{IMAGE_PREFIX}.")]
+                hint = (
+                    f"; a vision checkpoint: run it with --env.obs_type=pixels_state "
+                    f"--env.cameras='[{','.join(wanted)}]' --env.image_size={shape[-1]}"
+                )
             raise TaskMismatchError(
                 f"{where} expects input {key!r} {shape}, which task {spec.name!r} does not provide "
-                f"(it provides {', '.join(f'{k} {v}' for k, v in provided.items())})"
+                f"(it provides {', '.join(f'{k} {v}' for k, v in provided.items())}){hint}"
             )
         if shape != provided[key]:
             raise TaskMismatchError(
@@ -42,8 +54,8 @@ def check_policy_features(input_features: dict, output_features: dict, spec: Tas
         )
 
 
-def read_checkpoint_config(path: str | Path, spec: TaskSpec):
-    """The checkpoint's LeRobot config, checked against ``spec`` (no weights are loaded)."""
+def read_checkpoint_config(path: str | Path, spec: TaskSpec, cameras: CameraConfig | None = None):
+    """The checkpoint's LeRobot config, checked against ``spec`` and the observed ``cameras`` (no weights loaded)."""
     from lerobot.configs.policies import PreTrainedConfig
     from lerobot.utils.import_utils import register_third_party_plugins
 
@@ -57,19 +69,22 @@ def read_checkpoint_config(path: str | Path, spec: TaskSpec):
             "e.g. outputs/train/<run>/checkpoints/last/pretrained_model"
         )
     config = PreTrainedConfig.from_pretrained(path)
-    check_policy_features(config.input_features, config.output_features, spec, f"--policy.path={path}")
+    check_policy_features(config.input_features, config.output_features, spec, f"--policy.path={path}", cameras)
     return config
 
 
 class LeRobotCheckpointPolicy:
     """Loads ``pretrained_model/`` (config, weights, processors) and acts one step at a time."""
 
-    def __init__(self, path: str | Path, spec: TaskSpec, device: str = "cpu") -> None:
+    def __init__(
+        self, path: str | Path, spec: TaskSpec, device: str = "cpu", cameras: CameraConfig | None = None
+    ) -> None:
         import torch
         from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
         path = Path(path)
-        config = read_checkpoint_config(path, spec)
+        config = read_checkpoint_config(path, spec, cameras)
+        self.image_keys = [k for k in config.input_features if k.startswith(f"{IMAGE_PREFIX}.")]
         config.device = device
         self.policy = get_policy_class(config.type).from_pretrained(path, config=config)
         self.policy.eval()
@@ -91,6 +106,9 @@ class LeRobotCheckpointPolicy:
             OBS_ENV_STATE: torch.from_numpy(np.asarray(observation[OBS_ENV_STATE], dtype=np.float32))[None],
             "task": [self.instruction],
         }
+        for key in self.image_keys:  # (H, W, 3) uint8 -> (1, 3, H, W) float in [0, 1], as lerobot-eval does
+            image = torch.from_numpy(np.ascontiguousarray(observation[key]))
+            batch[key] = (image.permute(2, 0, 1).float() / 255.0)[None]
         with torch.inference_mode():
             action = self.postprocessor(self.policy.select_action(self.preprocessor(batch)))
         return action[0].cpu().numpy().astype(float)

@@ -27,7 +27,9 @@ def make_base_policy(cfg: PolicySourceConfig, env_config: TaskEnvConfig) -> Poli
     if cfg.path:
         from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 
-        return LeRobotCheckpointPolicy(cfg.path, env_config.task_spec, device=cfg.device)
+        return LeRobotCheckpointPolicy(
+            cfg.path, env_config.task_spec, device=cfg.device, cameras=env_config.image_cameras
+        )
     return env_config.make_scripted_policy()
 
 
@@ -37,4 +39,4 @@ def check_policy_source(cfg: PolicySourceConfig, env_config: TaskEnvConfig) -> N
         return
     from igen_lerobot.training.checkpoint_policy import read_checkpoint_config
 
-    read_checkpoint_config(cfg.path, env_config.task_spec)
+    read_checkpoint_config(cfg.path, env_config.task_spec, env_config.image_cameras)

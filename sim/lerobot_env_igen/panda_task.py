@@ -296,6 +296,9 @@ class PandaTaskEnv(TaskEnv):
                     "MuJoCo could not create an OpenGL context for rendering. On a headless machine set "
                     "MUJOCO_GL=egl before starting Python (and install libegl1/libgl1-mesa-dri: scripts/setup.sh)."
                 ) from err
+            # the table's mirror reflection draws the scene twice: half the frame rate on a software
+            # renderer for a barely visible effect (docs/benchmarks.md, camera streams)
+            self._renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
         self._renderer.update_scene(self.data, camera=PANDA_CAMERAS[camera], scene_option=self._render_option)
         return self._renderer.render()
 
