@@ -8,9 +8,9 @@ Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_render.py --task=block_gra
    wrist, at 84, 128 and 256 px (frames/s; one frame = both cameras), no encoding;
 2. ``igen-render`` end to end (restore, render, LeRobot's AV1 encoding, aggregation) at 128 px
    with 1 and 2 workers, frames/s of wall time;
-3. what state-only generation pays for the states: env steps/s of the scripted operator with and
-   without ``sim_state`` recorded per frame (same code, the state call switched off), and the
-   dataset write with and without the ``sim_state`` column (medians of 3 interleaved repeats);
+3. what state-only generation pays for the states: the ``sim_state`` call per step, env steps/s of
+   the scripted operator with and without it (same code, the call switched off; medians of 10
+   alternating rounds), and the dataset write with and without the column (medians of 6);
 4. ``igen-generate --mode=mimicgen`` of N episodes with 2 workers, with ``--render.cameras`` off
    and on (agentview + wrist, 128 px): wall time and the slowdown;
 5. dataset size per 1000 episodes: state only, and with two 84/128/256 px camera streams.
@@ -50,8 +50,12 @@ def render_rate(env, states, size: int) -> float:
     return len(states) / (time.perf_counter() - start)
 
 
-def state_cost(env_cfg, episodes: int) -> dict:
-    """Steps/s recording demos with and without the per-frame state, interleaved, medians of 3."""
+def state_cost(env_cfg, episodes: int, rounds: int = 10) -> dict:
+    """What recording the state costs per step: the call itself, and recording demos with and without it.
+
+    The A/B runs alternate (order flipped every round) and report medians: this VM's speed drifts by
+    +-20% from minute to minute, more than the effect measured.
+    """
     import dataclasses
 
     from igen_lerobot.collection.record import record_demo
@@ -61,9 +65,14 @@ def state_cost(env_cfg, episodes: int) -> dict:
     env_cfg = dataclasses.replace(env_cfg, corruption=NoNoise())
     env, operator = env_cfg.make_task_env(), env_cfg.make_scripted_operator()
     with_state = env.sim_state
+    env.reset(0)
+    start = time.perf_counter()
+    for _ in range(20000):
+        with_state()
+    call_us = 1e6 * (time.perf_counter() - start) / 20000
     rates: dict[str, list[float]] = {"with_state": [], "without_state": []}
-    for _ in range(3):
-        for label in ("with_state", "without_state"):
+    for r in range(rounds):
+        for label in ("with_state", "without_state")[:: 1 if r % 2 == 0 else -1]:
             env.sim_state = with_state if label == "with_state" else (lambda: None)
             steps, start = 0, time.perf_counter()
             for i in range(episodes):
@@ -72,11 +81,13 @@ def state_cost(env_cfg, episodes: int) -> dict:
     env.close()
     out = {f"record_steps_per_s_{k}": statistics.median(v) for k, v in rates.items()}
     out["record_slowdown"] = 1 - out["record_steps_per_s_with_state"] / out["record_steps_per_s_without_state"]
+    out["sim_state_call_us"] = call_us
+    out["sim_state_call_share_of_a_step"] = call_us * 1e-6 * out["record_steps_per_s_without_state"]
     return out
 
 
 def write_cost(spec, episodes) -> dict:
-    """Dataset write frames/s with and without the sim_state column, interleaved, medians of 3."""
+    """Dataset write frames/s with and without the sim_state column, alternating, medians of 6."""
     import copy
 
     from igen_lerobot.datasets.writer import write_lerobot_dataset
@@ -87,8 +98,9 @@ def write_cost(spec, episodes) -> dict:
     frames = sum(e.length for e in episodes)
     rates: dict[str, list[float]] = {"with_state": [], "without_state": []}
     with tempfile.TemporaryDirectory() as tmp:
-        for r in range(3):
-            for label, eps in (("with_state", episodes), ("without_state", bare)):
+        for r in range(6):
+            pairs = (("with_state", episodes), ("without_state", bare))
+            for label, eps in pairs[:: 1 if r % 2 == 0 else -1]:
                 start = time.perf_counter()
                 write_lerobot_dataset(Path(tmp) / f"{label}{r}", f"local/{label}", spec, eps, len(eps), {})
                 rates[label].append(frames / (time.perf_counter() - start))
@@ -177,8 +189,8 @@ def main() -> None:
         for size in (84, 128, 256):
             result[f"render_frames_per_s_per_core_{size}px"] = render_rate(env, states, size)
         env.close()
-        result.update(state_cost(env_cfg, max(5, args.episodes // 2)))
-        result.update(write_cost(spec, episodes))
+        result.update(state_cost(env_cfg, 4))
+        result.update(write_cost(spec, episodes * 5))
         shutil.rmtree(tmp / "off", ignore_errors=True)
     print(json.dumps(result, indent=2))
     if args.out:

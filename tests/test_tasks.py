@@ -155,8 +155,9 @@ def test_a_tiny_dataset_is_written_and_read_back_with_lerobot(config, tmp_path):
         np.testing.assert_array_equal(theirs.subtask, ours.subtask)
         if ours.sim_state is None:  # nothing simulated: no column, and the reader says so with None
             assert theirs.sim_state is None and SIM_STATE not in dataset.meta.features
-        else:  # stored as float64: bit for bit
+        else:  # stored as float64: bit for bit, and kept out of LeRobot's normalisation statistics
             np.testing.assert_array_equal(theirs.sim_state, ours.sim_state)
+            assert SIM_STATE not in dataset.meta.stats and OBS_STATE in dataset.meta.stats
     layout = read_igen_meta(tmp_path / "tiny").meta.get("sim_state_layout")
     assert layout == env.sim_state_layout()
     env.close()

@@ -28,7 +28,12 @@ from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_render import RenderConfig
 from igen_lerobot.datasets.reader import dataset_spec, read_igen_meta
 from igen_lerobot.datasets.schema import SIM_STATE, dataset_features, episode_frames
-from igen_lerobot.datasets.writer import IGEN_META_FILE, running_command, task_sim_state_layout
+from igen_lerobot.datasets.writer import (
+    IGEN_META_FILE,
+    running_command,
+    sim_state_stats_skipped,
+    task_sim_state_layout,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -110,21 +115,26 @@ def render_chunk(job: RenderJob) -> int:
     env = task_config_class(spec.name)(reveal=job.reveal).make_task_env()
     frames = 0
     try:
-        dataset = LeRobotDataset.create(
-            repo_id=f"local/{final.name}", fps=spec.fps, features=features, root=building, robot_type=spec.robot_type
-        )
-        for episode in episodes:
-            for t, frame in enumerate(episode_frames(episode, spec, with_sim_state=True)):
-                env.restore_sim_state(episode.sim_state[t])
-                images = render_images(env, cameras.cameras, cameras.size)
-                for camera, image in images.items():
-                    frame[image_key(camera)] = image
-                dataset.add_frame(frame)
-            # chunks are the parallel unit: no process pool per episode for its cameras (that pool
-            # costs a Python start per camera and episode, more than encoding a small video)
-            dataset.save_episode(parallel_encoding=False)
-            frames += episode.length
-        dataset.finalize()
+        with sim_state_stats_skipped():
+            dataset = LeRobotDataset.create(
+                repo_id=f"local/{final.name}",
+                fps=spec.fps,
+                features=features,
+                root=building,
+                robot_type=spec.robot_type,
+            )
+            for episode in episodes:
+                for t, frame in enumerate(episode_frames(episode, spec, with_sim_state=True)):
+                    env.restore_sim_state(episode.sim_state[t])
+                    images = render_images(env, cameras.cameras, cameras.size)
+                    for camera, image in images.items():
+                        frame[image_key(camera)] = image
+                    dataset.add_frame(frame)
+                # chunks are the parallel unit: no process pool per episode for its cameras (that
+                # pool costs a Python start per camera and episode, more than encoding a small video)
+                dataset.save_episode(parallel_encoding=False)
+                frames += episode.length
+            dataset.finalize()
     finally:
         env.close()
     building.rename(final)

@@ -8,6 +8,7 @@ and running the same command again resumes from it.
 from __future__ import annotations
 
 import contextlib
+import functools
 import itertools
 import json
 import logging
@@ -25,7 +26,7 @@ from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.episode import Episode
 from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError
 from igen_lerobot.core.task import TaskSpec
-from igen_lerobot.datasets.schema import SCHEMA_VERSION, dataset_features, episode_frames
+from igen_lerobot.datasets.schema import SCHEMA_VERSION, SIM_STATE, dataset_features, episode_frames
 from igen_lerobot.datasets.spool import EpisodeSpool
 
 logger = logging.getLogger(__name__)
@@ -54,6 +55,31 @@ def _image_embedding_skipped(features: dict[str, dict]) -> Iterator[None]:
         yield
     finally:
         dataset_writer.embed_images = original
+
+
+@contextlib.contextmanager
+def sim_state_stats_skipped() -> Iterator[None]:
+    """Leave ``complementary_info.sim_state`` out of LeRobot's per-episode statistics.
+
+    LeRobot computes min/max/mean/std and quantiles of every numeric column for normalisation; for
+    the simulator state (70-80 values, never a policy input) that was most of what recording it
+    cost a dataset write (docs/benchmarks.md). The column itself is written unchanged.
+    """
+    from lerobot.datasets import dataset_writer
+
+    original = dataset_writer.compute_episode_stats
+
+    def without_sim_state(episode_buffer: dict, features: dict) -> dict:
+        return original(
+            {k: v for k, v in episode_buffer.items() if k != SIM_STATE},
+            {k: v for k, v in features.items() if k != SIM_STATE},
+        )
+
+    dataset_writer.compute_episode_stats = without_sim_state
+    try:
+        yield
+    finally:
+        dataset_writer.compute_episode_stats = original
 
 
 @dataclass
@@ -191,7 +217,7 @@ def write_lerobot_dataset(
     frames = 0
     kinds: dict[str, int] = {}
     skip = _image_embedding_skipped(features) if fast_write else contextlib.nullcontext()
-    with skip:
+    with skip, sim_state_stats_skipped():
         for episode in tqdm(episodes, total=total, desc=desc, unit="ep"):
             for frame in episode_frames(episode, spec, with_sim_state=sim_size is not None):
                 dataset.add_frame(frame)
@@ -213,13 +239,21 @@ def write_lerobot_dataset(
 
 def task_sim_state_layout(spec: TaskSpec) -> dict | None:
     """The layout of the task's simulator state, from the installed task (None: it has no simulator)."""
+    layout = _installed_layout(spec.name)
+    return None if layout is None else json.loads(layout)
+
+
+@functools.cache
+def _installed_layout(task: str) -> str | None:
+    """JSON of the installed task's state layout (building the task's scene once per process)."""
     from igen_lerobot.core.env_config import task_config_class
 
-    env = task_config_class(spec.name)().make_task_env()
+    env = task_config_class(task)().make_task_env()
     try:
-        return env.sim_state_layout()
+        layout = env.sim_state_layout()
     finally:
         env.close()
+    return None if layout is None else json.dumps(layout)
 
 
 def _checked_layout(spec: TaskSpec, layout: dict | None, size: int) -> dict:
