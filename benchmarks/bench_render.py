@@ -128,9 +128,17 @@ def main() -> None:
     parser.add_argument("--sources", required=True, help="an igen-collect demos dataset (with simulator states)")
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--out", default=None)
+    parser.add_argument("--state-cost-only", action="store_true", help="only step 3, on the --sources dataset")
     args = parser.parse_args()
     env_cfg = task_config_class(args.task)()
     result: dict = {"task": args.task, "episodes": args.episodes}
+    if args.state_cost_only:
+        os.sched_setaffinity(0, {0})
+        spec = dataset_spec(Path(args.sources))
+        result.update(state_cost(env_cfg, 4))
+        result.update(write_cost(spec, load_episodes(Path(args.sources), spec) * 10))
+        print(json.dumps(result, indent=2))
+        return
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         # the base data: generated MimicGen demos, state only, then with cameras on

@@ -58,6 +58,28 @@ def _image_embedding_skipped(features: dict[str, dict]) -> Iterator[None]:
 
 
 @contextlib.contextmanager
+def _fingerprint_hashing_skipped() -> Iterator[None]:
+    """Give each episode's in-memory ``datasets.Dataset`` a random fingerprint instead of a hash of its data.
+
+    LeRobot's writer wraps every episode in a ``datasets.Dataset`` on its way to parquet, and
+    ``datasets`` fingerprints it by pickling and hashing the whole table: a third of the write
+    time, growing with the data. The fingerprint only names cache files, which this path never
+    writes; ``datasets`` itself falls back to random fingerprints. The parquet bytes are unchanged
+    (``tests/test_dataset_io.py``).
+    """
+    import uuid
+
+    from datasets import arrow_dataset
+
+    original = arrow_dataset.generate_fingerprint
+    arrow_dataset.generate_fingerprint = lambda dataset: uuid.uuid4().hex
+    try:
+        yield
+    finally:
+        arrow_dataset.generate_fingerprint = original
+
+
+@contextlib.contextmanager
 def sim_state_stats_skipped() -> Iterator[None]:
     """Leave ``complementary_info.sim_state`` out of LeRobot's per-episode statistics.
 
@@ -216,8 +238,11 @@ def write_lerobot_dataset(
     )
     frames = 0
     kinds: dict[str, int] = {}
-    skip = _image_embedding_skipped(features) if fast_write else contextlib.nullcontext()
-    with skip, sim_state_stats_skipped():
+    fast = contextlib.ExitStack()
+    if fast_write:
+        fast.enter_context(_image_embedding_skipped(features))
+        fast.enter_context(_fingerprint_hashing_skipped())
+    with fast, sim_state_stats_skipped():
         for episode in tqdm(episodes, total=total, desc=desc, unit="ep"):
             for frame in episode_frames(episode, spec, with_sim_state=sim_size is not None):
                 dataset.add_frame(frame)
