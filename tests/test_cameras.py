@@ -300,3 +300,16 @@ def test_the_dataset_card_lists_the_cameras(rendered):
         f"**Cameras** (2): `observation.images.agentview` ({SIZE}x{SIZE} px, video), "
         f"`observation.images.wrist` ({SIZE}x{SIZE} px, video), rendered from the recorded simulator states"
     ) in body
+
+
+def test_two_render_workers_write_what_one_writes(demos, rendered, tmp_path):
+    """Chunks rendered by two processes and joined in order give the single-process dataset."""
+    out = tmp_path / "two"
+    render_dataset(demos, out, "local/two", CameraConfig(["agentview", "wrist"], SIZE), num_workers=2)
+    one, two = LeRobotDataset("local/r", root=rendered), LeRobotDataset("local/two", root=out)
+    assert two.meta.total_episodes == one.meta.total_episodes == 3
+    np.testing.assert_array_equal(np.asarray(two.hf_dataset["action"]), np.asarray(one.hf_dataset["action"]))
+    for i in (0, len(one) // 2, len(one) - 1):
+        for camera in ("agentview", "wrist"):
+            a, b = one[i][image_key(camera)].numpy(), two[i][image_key(camera)].numpy()
+            assert np.abs(a - b).max() < 1e-6, (i, camera)  # same pixels, same encoder settings
