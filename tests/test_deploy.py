@@ -403,21 +403,23 @@ def test_a_jump_the_cube_could_not_make_is_rejected_bridged_and_recorded(sim_arm
     assert outcome.to_json()["rejected_jumps"] == outcome.rejected_jumps
 
 
-def test_low_confidence_estimates_are_not_acted_on(sim_arm):
-    from lerobot_robot_igen.pose_gate import PoseGateSettings
-    from lerobot_robot_igen.pose_source import RenderedICPPose
+class DoubtfulCamera(SimTruthPose):
+    """The true pose, rated 0.5 by its estimator (a fit that leaves half its evidence unexplained)."""
 
-    settings = LoopSettings(
-        realtime=False, contact_force_threshold=0.0, max_pose_age=0.2, pose_gate=PoseGateSettings(min_confidence=1.0)
-    )
-    camera = RenderedICPPose(sim_arm)
-    try:
-        outcome, _ = run(sim_arm, scripted_policy(), poses=camera, settings=settings)
-    finally:
-        camera.close()
-    # no estimate is perfect on D415 frames: the first one is not trusted and there is nothing to bridge with
+    def read(self):
+        from lerobot_robot_igen.perception.cube_pose import CubePoseEstimate
+
+        reading = super().read()
+        reading.estimate = CubePoseEstimate(reading.T_base_cube, fitness=0.5, rmse=0.002, num_points=300, seconds=0.0)
+        return reading
+
+
+def test_low_confidence_estimates_are_not_acted_on(sim_arm):
+    settings = LoopSettings(realtime=False, contact_force_threshold=0.0, max_pose_age=0.2)  # min_confidence 0.8
+    outcome, _ = run(sim_arm, scripted_policy(), poses=DoubtfulCamera(sim_arm), settings=settings)
+    # the first estimate is not trusted and there is nothing to bridge with: the arm never moves
     assert outcome.steps == 0 and outcome.low_confidence == 1
-    assert "confidence" in outcome.fault and "no estimate yet" in outcome.fault
+    assert "confidence 0.50 < min_confidence 0.8" in outcome.fault and "no estimate yet" in outcome.fault
 
 
 def test_pose_gate_settings_name_the_field():
