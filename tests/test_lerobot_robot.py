@@ -244,6 +244,7 @@ def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, arm, 
         "--dataset.video=false",
         "--dataset.push_to_hub=false",
         "--play_sounds=false",
+        f"--robot.trace={tmp_path / 'trace.jsonl'}",  # each target received and sent, and the hand after it
     ]
     lines, proc = [], None
     try:
@@ -270,7 +271,8 @@ def test_lerobot_record_with_a_keyboard_as_end_effector_targets(x_display, arm, 
         if proc is not None and proc.poll() is None:
             proc.kill()
         arm_context.close()
-    assert proc.returncode == 0, "".join(lines)[-3000:]
+    trace = (tmp_path / "trace.jsonl").read_text().splitlines() if (tmp_path / "trace.jsonl").exists() else []
+    assert proc.returncode == 0, "".join(lines)[-2000:] + "\nlast targets:\n" + "\n".join(trace[-12:])
     dataset = LeRobotDataset(repo_id, root=root)
     assert dataset.num_episodes == 1 and dataset.num_frames >= 0.8 * 6 * FPS
     names = dataset.features["action"]["names"]
