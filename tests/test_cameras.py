@@ -105,8 +105,11 @@ def test_rendered_frames_are_the_env_observation_of_the_recorded_state(demos, re
 
 def test_render_refuses_what_it_cannot_render_and_leaves_nothing(demos, tmp_path):
     before = _digest(demos)
-    with pytest.raises(ConfigError, match=r"has no camera 'top'; its cameras: \['agentview', 'wrist'"):
+    unknown = r"^--cameras: task 'block_grasp' has no camera 'top'; its cameras: \['agentview'"
+    with pytest.raises(ConfigError, match=unknown):
         render_dataset(demos, tmp_path / "a", "local/a", CameraConfig(["top"], SIZE))
+    with pytest.raises(ConfigError, match=r"^--size=4 px is out of range"):
+        render_dataset(demos, tmp_path / "a", "local/a", CameraConfig(["wrist"], 4))
     with pytest.raises(ConfigError, match="the input is never modified"):
         render_dataset(demos, demos, "local/a", CameraConfig(["wrist"], SIZE))
     # a dataset written before simulator states were recorded
@@ -156,7 +159,8 @@ def test_a_killed_render_resumes_without_ever_showing_a_half_written_dataset(dem
     assert dataset.meta.total_episodes == 3 and dataset.meta.total_frames == source.meta.total_frames
     np.testing.assert_array_equal(np.asarray(dataset.hf_dataset["action"]), np.asarray(source.hf_dataset["action"]))
     bad = subprocess.run([*command[:-3], "--cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=600)
-    assert bad.returncode == 2 and "has no camera 'top'; its cameras:" in bad.stderr and "Traceback" not in bad.stderr
+    assert bad.returncode == 2 and "--cameras: task 'block_grasp' has no camera 'top'" in bad.stderr
+    assert "Traceback" not in bad.stderr
 
 
 def test_act_trains_on_a_rendered_dataset_and_lerobot_eval_runs_it_on_the_env_cameras(rendered, tmp_path):
@@ -262,7 +266,8 @@ def test_igen_collect_renders_cameras_into_the_dataset_it_writes(tmp_path, demos
         bad = subprocess.run(
             [str(BIN / command), *args, "--render.cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=600
         )
-        assert bad.returncode == 2 and "has no camera 'top'; its cameras:" in bad.stderr, bad.stderr[-2000:]
+        flag = "--render.cameras: task 'block_grasp' has no camera 'top'; its cameras:"
+        assert bad.returncode == 2 and flag in bad.stderr, bad.stderr[-2000:]
         assert not (tmp_path / "x").exists() and not (tmp_path / "x.partial").exists()
 
 
@@ -313,3 +318,13 @@ def test_two_render_workers_write_what_one_writes(demos, rendered, tmp_path):
         for camera in ("agentview", "wrist"):
             a, b = one[i][image_key(camera)].numpy(), two[i][image_key(camera)].numpy()
             assert np.abs(a - b).max() < 1e-6, (i, camera)  # same pixels, same encoder settings
+
+
+def test_the_env_config_names_its_own_flags_for_bad_cameras(block_grasp_config):
+    config_class = type(block_grasp_config)
+    with pytest.raises(ConfigError, match=r"^--env.cameras: task 'block_grasp' has no camera 'top'; its cameras"):
+        config_class(obs_type="pixels_state", cameras=["top"])
+    with pytest.raises(ConfigError, match=r"^--env.image_size=4 px is out of range"):
+        config_class(obs_type="pixels_state", image_size=4)
+    with pytest.raises(ConfigError, match=r"env.obs_type='pixels' is not one of \['state', 'pixels_state'\]"):
+        config_class(obs_type="pixels")

@@ -34,12 +34,15 @@ class CameraConfig:
     cameras: list[str] = field(default_factory=list)  # empty: state only
     size: int = 128
 
-    def check(self, spec: TaskSpec, flag: str = "--render") -> None:
-        """Raise :class:`ConfigError` for a camera the task lacks (listing its cameras) or a bad size."""
-        check_cameras(spec, self.cameras, f"{flag}.cameras")
+    def check(self, spec: TaskSpec, cameras_flag: str = "--render.cameras", size_flag: str = "--render.size") -> None:
+        """Raise :class:`ConfigError` for a camera the task lacks (listing its cameras) or a bad size.
+
+        The flags are the command's own names for the two fields, so the message names what to change.
+        """
+        check_cameras(spec, self.cameras, cameras_flag)
         if not MIN_SIZE <= int(self.size) <= MAX_SIZE:
             raise ConfigError(
-                f"{flag}.size={self.size} px is out of range; use {MIN_SIZE}..{MAX_SIZE} (e.g. 84, 128, 256)"
+                f"{size_flag}={self.size} px is out of range; use {MIN_SIZE}..{MAX_SIZE} (e.g. 84, 128, 256)"
             )
 
     def features(self) -> dict[str, dict]:

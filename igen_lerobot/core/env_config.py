@@ -85,7 +85,7 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
         if self.obs_type not in OBS_TYPES:
             raise ConfigError(f"env.obs_type={self.obs_type!r} is not one of {list(OBS_TYPES)}")
         if self.image_cameras.cameras:
-            self.image_cameras.check(spec, flag="--env")
+            self.image_cameras.check(spec, "--env.cameras", "--env.image_size")
         self.features, self.features_map = lerobot_features(self.task_spec, self.image_cameras)
 
     @property

@@ -68,7 +68,7 @@ def check_renderable(root: Path, spec: TaskSpec, cameras: CameraConfig, flag: st
     from lerobot.datasets.dataset_metadata import LeRobotDatasetMetadata
 
     meta = read_igen_meta(root, flag).meta
-    cameras.check(spec, flag="--cameras" if flag == "--dataset.root" else flag)
+    cameras.check(spec, "--cameras", "--size")
     features = LeRobotDatasetMetadata(f"local/{Path(root).name}", root=root).features
     if SIM_STATE not in features:
         raise DatasetSchemaError(
