@@ -35,7 +35,17 @@ IGEN_META_FILE = "meta/igen.json"
 
 
 @contextlib.contextmanager
-def _image_embedding_skipped(features: dict[str, dict]) -> Iterator[None]:
+def _replaced(module, name: str, replacement) -> Iterator[None]:
+    """``module.name`` is ``replacement`` inside the block (LeRobot/datasets internals our writes bypass)."""
+    original = getattr(module, name)
+    setattr(module, name, replacement)
+    try:
+        yield
+    finally:
+        setattr(module, name, original)
+
+
+def _image_embedding_skipped(features: dict[str, dict]) -> contextlib.AbstractContextManager:
     """Skip LeRobot's per-row image-embedding pass when a dataset has no image columns.
 
     ``DatasetWriter`` maps ``embed_table_storage`` over every row of every episode; with no
@@ -47,18 +57,11 @@ def _image_embedding_skipped(features: dict[str, dict]) -> Iterator[None]:
     if any(ft["dtype"] in ("image", "video") for ft in features.values()) or not hasattr(
         dataset_writer, "embed_images"
     ):
-        yield
-        return
-    original = dataset_writer.embed_images
-    dataset_writer.embed_images = lambda dataset: dataset
-    try:
-        yield
-    finally:
-        dataset_writer.embed_images = original
+        return contextlib.nullcontext()
+    return _replaced(dataset_writer, "embed_images", lambda dataset: dataset)
 
 
-@contextlib.contextmanager
-def _fingerprint_hashing_skipped() -> Iterator[None]:
+def _fingerprint_hashing_skipped() -> contextlib.AbstractContextManager:
     """Give each episode's in-memory ``datasets.Dataset`` a random fingerprint instead of a hash of its data.
 
     LeRobot's writer wraps every episode in a ``datasets.Dataset`` on its way to parquet, and
@@ -71,16 +74,10 @@ def _fingerprint_hashing_skipped() -> Iterator[None]:
 
     from datasets import arrow_dataset
 
-    original = arrow_dataset.generate_fingerprint
-    arrow_dataset.generate_fingerprint = lambda dataset: uuid.uuid4().hex
-    try:
-        yield
-    finally:
-        arrow_dataset.generate_fingerprint = original
+    return _replaced(arrow_dataset, "generate_fingerprint", lambda dataset: uuid.uuid4().hex)
 
 
-@contextlib.contextmanager
-def sim_state_stats_skipped() -> Iterator[None]:
+def sim_state_stats_skipped() -> contextlib.AbstractContextManager:
     """Leave ``complementary_info.sim_state`` out of LeRobot's per-episode statistics.
 
     LeRobot computes min/max/mean/std and quantiles of every numeric column for normalisation; for
@@ -97,11 +94,7 @@ def sim_state_stats_skipped() -> Iterator[None]:
             {k: v for k, v in features.items() if k != SIM_STATE},
         )
 
-    dataset_writer.compute_episode_stats = without_sim_state
-    try:
-        yield
-    finally:
-        dataset_writer.compute_episode_stats = original
+    return _replaced(dataset_writer, "compute_episode_stats", without_sim_state)
 
 
 @dataclass
