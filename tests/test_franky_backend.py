@@ -210,7 +210,7 @@ def test_igen_deploy_rehearses_igen_evals_trials_through_franky_on_franky_sim():
             robot=FrankyArmConfig(host=server.host),
             perception=FrankySimPerceptionConfig(port=server.scene_port),
             trials=2,
-            max_steps=30,
+            max_steps=60,
             compare_sim=True,
         )
         assert cfg.realtime and not cfg.prompt and cfg.rehearsal

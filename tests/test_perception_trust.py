@@ -85,19 +85,19 @@ def test_dev_and_test_frames_never_share_a_seed_and_are_reproducible(views):
 
 
 def test_occluded_frames_give_right_poses_or_rejections(views):
-    """8 occluded + 4 clean frames of the test split (never tuned on). Tolerances: no accepted pose
-    more than 2 cm off; every clean frame accepted; at most 2 of 8 occluded rejected (the benchmark
+    """12 occluded + 6 clean frames of the test split (never tuned on). Tolerances: no accepted pose
+    more than 2 cm off; every clean frame accepted; at most 3 of 12 occluded rejected (the benchmark
     measures the rate on 100); median error over accepted frames <= 2 mm."""
     intrinsics = Intrinsics(*views.camera.intrinsics())
     scores = []
-    for occluded, count in ((False, 4), (True, 8)):
+    for occluded, count in ((False, 6), (True, 12)):
         for view in views.frames("test", count, occluded):
             scores.append(score_frame(CubePoseEstimator(intrinsics, view.T_world_camera), view))
     clean = summarize([s for s in scores if not s.occluded])
     occluded = summarize([s for s in scores if s.occluded])
     assert clean["gross"] == 0 and occluded["gross"] == 0, [s for s in scores if s.gross]
     assert clean["rejected"] == 0, [s.reason for s in scores if not s.occluded and not s.accepted]
-    assert occluded["rejected"] <= 2, [s.reason for s in scores if s.occluded and not s.accepted]
+    assert occluded["rejected"] <= 3, [s.reason for s in scores if s.occluded and not s.accepted]
     assert summarize(scores)["pos_err_mm_median"] <= 2.0
 
 

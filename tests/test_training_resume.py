@@ -29,3 +29,11 @@ def test_a_run_stopped_after_a_checkpoint_resumes_from_it(source_demos, tmp_path
     assert (out / "checkpoints" / "000002" / "pretrained_model" / "model.safetensors").read_bytes() == first_weights
     log = (tmp_path / "bc_rnn.log").read_text()
     assert "'resume': True" in log and "Resuming data order" in log
+
+
+def test_a_run_without_a_checkpoint_starts_again(source_demos, tmp_path):
+    out = tmp_path / "bc_rnn"
+    (out / "checkpoints").mkdir(parents=True)  # killed before its first save
+    cfg = TrainConfig(policy_type="bc_rnn", steps=2, batch_size=8, num_workers=0)
+    done = lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
+    assert _step(done) == 2 and is_finished(out, 2)
