@@ -131,6 +131,45 @@ def test_the_deployment_loop_grasps_and_lifts_the_cube_at_20hz():
     assert 45.0 < period["median_ms"] < 55.0 and period["max_ms"] < 100.0, period
 
 
+def test_touching_the_cube_is_felt_and_a_closing_grasp_reopens_at_once():
+    """The loop's contact (which reveals the true pose) is the arm's external force estimate: franky-sim's
+    server reports the hand's contact force there (zeros in free space, the push once the fingers land on
+    the cube). Opening while a grasp is still closing must not wait for the grasp (the 20 Hz loop would
+    stall and the watchdog stop the arm)."""
+    with franky_sim(cube=CUBE_BASE) as server:
+        arm = connected(server.host)
+        safe = SafeArm(arm, world_from_base(), SafetyLimits())
+        try:
+            arm.move_home()
+            arm.set_gripper(True)  # closing on air
+            time.sleep(0.1)
+            start = time.perf_counter()
+            arm.set_gripper(False)
+            reopen_call = time.perf_counter() - start
+            arm.wait_gripper(5.0)  # the grasp settles on air, then the opening runs
+            assert arm.read_state().gripper_width > 0.07  # open again
+            arm.set_gripper(True)  # closed fingers: they land on the cube's top face
+            arm.wait_gripper(5.0)
+            free, felt = [], None
+            for _ in range(80):  # 4 s at 20 Hz, 1 cm per period towards 1 cm under the cube's top
+                state, T = safe.read()
+                base_z = state.T_base_eef[2, 3]
+                if state.external_force > 2.0:
+                    felt = base_z
+                    break
+                free.append(state.external_force)
+                goal = np.array([*CUBE_BASE, 0.04]) - state.T_base_eef[:3, 3]
+                safe.command(T, np.clip(goal, -0.01, 0.01), close_gripper=True, period=0.05)
+                time.sleep(0.05)
+        finally:
+            safe.close()
+            arm.disconnect()
+    assert reopen_call < 0.01, f"opening waited {reopen_call:.3f} s for the grasp"
+    assert max(free) < 0.5, f"force felt in free space: {max(free):.2f} N"  # tolerance: no contact, no force
+    # the cube's top is 5 cm above the floor; the closed fingertips reach it with the grip site a little above
+    assert felt is not None and 0.04 < felt < 0.08, felt
+
+
 def test_a_lost_connection_mid_stream_stops_with_a_clear_error():
     with franky_sim(cube=None) as server:
         arm = connected(server.host)

@@ -10,6 +10,13 @@ tools/franky_sim/serve.py --hostname 127.0.0.1 [--cube 0.5 0.0] [--scene-port 77
 ``{"cmd": "place", "x": .., "y": .., "yaw": ..}`` puts it back on the floor there, at rest. This
 stands in for the camera a real cell has (franky-sim renders none) and lets a rehearsal place the
 cube per trial without restarting the robot.
+
+franky-sim reports the external wrench ``O_F_ext_hat_K`` as zeros, so an arm touching the cube
+would never feel it and the deployment loop's force-based contact (which reveals the true pose)
+could not fire. This server fills its force part with the net contact force that everything
+outside the robot exerts on the hand and fingers (MuJoCo's contact forces, base frame): what a
+real arm's FCI estimates from joint torques, without its bias and noise. The driver reads it
+through the libfranka protocol exactly as on a real arm.
 """
 
 import argparse
@@ -20,7 +27,11 @@ import threading
 import xml.etree.ElementTree as ET
 
 import franky_sim
-from franky_sim.mujoco_simulator import MujocoSimulator
+import mujoco
+import numpy as np
+from franky_sim.mujoco_simulator import FrankaMujocoRobot, MujocoSimulator
+
+HAND_BODIES = ("hand", "left_finger", "right_finger")  # after franky-sim's robot prefix
 
 
 def main() -> None:
@@ -30,6 +41,7 @@ def main() -> None:
     parser.add_argument("--cube", type=float, nargs=2, default=None, metavar=("X", "Y"), help="cube position [m]")
     parser.add_argument("--scene-port", type=int, default=None, help="serve the cube's pose and placement here")
     args = parser.parse_args()
+    _report_hand_contact_wrench()
     with MujocoSimulator(enable_visualization=False) as sim:
         if args.cube is not None:
             x, y = args.cube
@@ -45,6 +57,44 @@ def main() -> None:
                 threading.Thread(target=scene.serve_forever, name="cube-scene", daemon=True).start()
             print("READY", flush=True)
             server.run_forever()
+
+
+def hand_contact_force(model, data, hand: set[int]) -> np.ndarray:
+    """Net force [N, world = base frame] that bodies outside the robot exert on the ``hand`` bodies."""
+    total = np.zeros(3)
+    wrench = np.zeros(6)
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        body1, body2 = model.geom_bodyid[contact.geom1], model.geom_bodyid[contact.geom2]
+        on_hand1, on_hand2 = body1 in hand, body2 in hand
+        robot1 = on_hand1 or model.body_rootid[body1] == model.body_rootid[next(iter(hand))]
+        robot2 = on_hand2 or model.body_rootid[body2] == model.body_rootid[next(iter(hand))]
+        if robot1 == robot2 or not (on_hand1 or on_hand2):
+            continue  # robot-robot, world-world, or a contact on the arm's links (not the hand)
+        mujoco.mj_contactForce(model, data, i, wrench)
+        force = contact.frame.reshape(3, 3).T @ wrench[:3]  # on geom2, pushed along the normal from geom1
+        total += force if on_hand2 else -force
+    return total
+
+
+def _report_hand_contact_wrench() -> None:
+    """Make franky-sim's robot state carry the hand's contact force as ``O_F_ext_hat_K`` (see module doc)."""
+    original = FrankaMujocoRobot.state
+
+    def state(robot):
+        snapshot = original.fget(robot)
+        model, data = robot.model, robot.data
+        if model is None or data is None:
+            return snapshot
+        hand = getattr(robot, "_igen_hand_bodies", None)
+        if hand is None:
+            names = {model.body(i).name: i for i in range(model.nbody)}
+            hand = {i for name, i in names.items() if name.endswith(HAND_BODIES) and name.startswith("robot")}
+            robot._igen_hand_bodies = hand
+        force = hand_contact_force(model, data, hand)
+        return snapshot.replace(O_F_ext_hat_K=(*force.tolist(), 0.0, 0.0, 0.0))
+
+    FrankaMujocoRobot.state = property(state)
 
 
 def _scene_handler(sim):

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lerobot_robot_igen.backends.gripper_worker import GripperWorker
 from lerobot_robot_igen.config_arm import ArmBackendConfig
 from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError, DriverError
 
@@ -50,12 +51,14 @@ class FrankyArmConfig(ArmBackendConfig):
     jerk_factor: float = 0.05
     home_position: tuple[float, float, float] = (0.51, 0.0, 0.2)  # [m] base frame, hand top-down
     home_velocity_factor: float = 0.2  # the (blocking) move home; acceleration and jerk as above
-    grasp_width: float = 0.05  # [m] the 5 cm cube
-    grasp_tolerance: float = 0.04  # [m] epsilon in/out of the grasp: succeed on anything roughly cube-sized
+    # [m] 1 cm under the 5 cm cube: a real hand applies grasp_force once its fingers stop on the cube,
+    # whatever the width; franky-sim drives its fingers towards the width, and squeezes only below the cube
+    grasp_width: float = 0.04
+    grasp_tolerance: float = 0.03  # [m] epsilon in/out: a grasp stopping at 1-7 cm (anything cube-sized) succeeds
     grasp_force: float = 20.0  # [N]
     gripper_speed: float = 0.1  # [m/s]
     open_width: float = 0.08  # [m]
-    gripper_timeout: float = 5.0  # [s] the longest a gripper command may take before the next is sent
+    gripper_timeout: float = 5.0  # [s] the longest a gripper command may take (waited for at home and disconnect)
     settle_timeout: float = 3.0  # [s] the longest the move home waits for the last target's motion
     tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
 
@@ -63,7 +66,7 @@ class FrankyArmConfig(ArmBackendConfig):
         return FrankyArm(self)
 
 
-_STILL_RUNNING: list = []  # gripper commands that outlived their driver, kept so their threads never see freed memory
+_STILL_RUNNING: list = []  # gripper workers that outlived their driver, kept so their threads never see freed memory
 
 
 class FrankyArm(ArmDriver):
@@ -74,8 +77,8 @@ class FrankyArm(ArmDriver):
         self.robot = None
         self.gripper = None
         self._franky = None
-        self._gripper_closed: bool | None = None
-        self._pending = None  # the last gripper future
+        self._gripper_closed: bool | None = None  # the state last asked for
+        self._gripper_worker: GripperWorker | None = None
         self._T_tcp_site = np.eye(4)
         self._T_tcp_site[:3, :3] = np.asarray(config.tcp_to_site_rotation, dtype=float)
         self._T_site_tcp = np.linalg.inv(self._T_tcp_site)
@@ -118,6 +121,12 @@ class FrankyArm(ArmDriver):
                 "network cable, and that FCI is enabled in Desk"
             ) from error
         self.robot, self.gripper = robot, gripper
+        self._gripper_worker = GripperWorker(
+            close=lambda: gripper.grasp(
+                cfg.grasp_width, cfg.gripper_speed, cfg.grasp_force, cfg.grasp_tolerance, cfg.grasp_tolerance
+            ),
+            open_=lambda: gripper.move(cfg.open_width, cfg.gripper_speed),
+        )
         self._call("error recovery", robot.recover_from_errors)
         robot.relative_dynamics_factor = franky.RelativeDynamicsFactor(
             cfg.velocity_factor, cfg.acceleration_factor, cfg.jerk_factor
@@ -130,17 +139,13 @@ class FrankyArm(ArmDriver):
                 self.stop()
             except DriverError as error:  # a reflex: the arm is already stopped
                 logger.warning("stopping before disconnect failed: %s", error)
-        if self._pending is not None:
-            # a gripper command still running uses the Gripper from its own thread: freeing the
+        if self._gripper_worker is not None:
+            # a gripper command still running uses the Gripper from the worker's thread: freeing the
             # Gripper under it crashes the process, so let it finish (bounded), and if it does not,
             # keep both alive for the life of the process
-            try:
-                finished = bool(self._pending.wait(self.config.gripper_timeout))
-            except Exception:  # noqa: BLE001 - a failed grasp is finished too
-                finished = True
-            if not finished:
-                _STILL_RUNNING.append((self.gripper, self._pending))
-            self._pending = None
+            if not self._gripper_worker.close(self.config.gripper_timeout):
+                _STILL_RUNNING.append((self.gripper, self._gripper_worker))
+            self._gripper_worker = None
         self.robot = self.gripper = None
 
     @property
@@ -176,28 +181,22 @@ class FrankyArm(ArmDriver):
         self._call("a Cartesian target", self.robot.move, motion, asynchronous=True)
 
     def set_gripper(self, closed: bool) -> None:
-        cfg = self.config
-        if closed == self._gripper_closed:
-            return
-        if self._pending is not None:
-            # the gripper runs one command at a time: a new one sent while a grasp is still closing
-            # (or failing on air) blocks until that finishes, so wait for it here, bounded
-            self._call("the previous gripper command", self._pending.wait, cfg.gripper_timeout)
-        if closed:
-            self._pending = self._call(
-                "a grasp",
-                self.gripper.grasp_async,
-                cfg.grasp_width,
-                cfg.gripper_speed,
-                cfg.grasp_force,
-                cfg.grasp_tolerance,
-                cfg.grasp_tolerance,
-            )
-        else:
-            self._pending = self._call(
-                "opening the gripper", self.gripper.move_async, cfg.open_width, cfg.gripper_speed
-            )
-        self._gripper_closed = closed
+        """Ask for the fingers closed (a grasp) or open; returns at once (see ``gripper_worker``)."""
+        if self._gripper_worker is None:
+            raise ConnectionLostError(f"not connected to the robot at {self.config.host}: call connect() first")
+        error = self._gripper_worker.take_error()
+        if error is not None:
+            raise self._fail("a gripper command", error) from error
+        if closed != self._gripper_closed:
+            self._gripper_worker.want(closed)
+            self._gripper_closed = closed
+
+    def wait_gripper(self, timeout: float) -> None:
+        """Block until the last gripper state asked for is reached (the move home, tests)."""
+        if self._gripper_worker is not None and not self._gripper_worker.wait_idle(timeout):
+            raise DriverError(f"the gripper did not finish its command within {timeout} s")
+        if self._gripper_worker is not None and (error := self._gripper_worker.take_error()) is not None:
+            raise self._fail("a gripper command", error) from error
 
     def stop(self) -> None:
         if self.robot is None:
@@ -245,5 +244,4 @@ class FrankyArm(ArmDriver):
             self._finish_last_motion()
             self._call("the move home", self.robot.move, self._motion(T_home, factor))
         self.set_gripper(False)
-        if self._pending is not None:
-            self._call("opening the gripper", self._pending.wait, 5.0)
+        self.wait_gripper(2 * self.config.gripper_timeout)  # a grasp still settling, then the opening
