@@ -109,9 +109,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--server", choices=["franky-sim", "franka-sim"], default="franky-sim")
     parser.add_argument("--python", default=None, help="interpreter of the simulator's environment")
+    parser.add_argument(
+        "--settings", nargs="+", default=None, metavar="V,A,J", help="dynamics factors to try (default: the table's)"
+    )
     args = parser.parse_args()
     host = "127.0.0.1" if args.server == "franka-sim" else "127.0.0.9"
-    for factors in SETTINGS:
+    settings = [tuple(float(x) for x in s.split(",")) for s in args.settings] if args.settings else SETTINGS
+    for factors in settings:
         proc = start_server(args.server, args.python, host)
         try:
             print(json.dumps({"server": args.server, **stream(host, factors)}), flush=True)

@@ -126,8 +126,12 @@ def test_a_trained_checkpoint_deploys(bc_rnn_checkpoint):
         perception=TruthPerceptionConfig(),
         trials=1,
         max_steps=30,
+        inference_threads=1,
     )
     report = deploy(cfg)
+    import torch
+
+    assert torch.get_num_threads() == 1  # one inference thread: no pool stalls in the 20 Hz loop
     assert report["per_trial"][0]["steps"] == 30 or report["per_trial"][0]["success"]
     assert report["policy"] == str(bc_rnn_checkpoint)
 
@@ -302,6 +306,8 @@ def test_config_errors_name_the_field():
         DeployConfig(robot=RealLike(), perception=RealSensePerceptionConfig(calibration="c.json"), compare_sim=True)
     with pytest.raises(ConfigError, match="trials"):
         DeployConfig(trials=0)
+    with pytest.raises(ConfigError, match="--inference_threads"):
+        DeployConfig(inference_threads=0)
 
 
 def test_camera_not_found_and_missing_calibration_are_clear(tmp_path):

@@ -92,6 +92,9 @@ class DeployConfig:
     )
     reveal: Reveal = Reveal.FULL
     fps: int = 20
+    # CPU inference threads: a small policy gains nothing from a pool, and on a busy machine (the arm's
+    # 1 kHz control thread, a camera) a 2-thread pool stalled single steps up to 90 ms
+    inference_threads: int = 1
     max_steps: int = 200
     contact_force_threshold: float = 2.0  # [N]
     max_pose_age: float = 0.5  # [s]
@@ -107,6 +110,8 @@ class DeployConfig:
     def __post_init__(self) -> None:
         if self.trials < 1:
             raise ConfigError(f"--trials must be >= 1, got {self.trials}")
+        if self.inference_threads < 1:
+            raise ConfigError(f"--inference_threads must be >= 1, got {self.inference_threads}")
         if self.contact_force_threshold < 0:
             raise ConfigError(f"--contact_force_threshold must be >= 0 [N], got {self.contact_force_threshold}")
         if self.max_pose_age < 0:

@@ -108,6 +108,9 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
 
     env_cfg = BlockGraspEnvConfig()
     check_deployable(env_cfg.task_spec)
+    import torch
+
+    torch.set_num_threads(cfg.inference_threads)
     policy = make_base_policy(cfg.policy, env_cfg)
     # the task's MuJoCo scene is needed before the arm: igen-eval's rollouts for --compare_sim, and the
     # situations a franky-sim rehearsal recreates (done first, so no arm idles connected meanwhile)
