@@ -9,15 +9,17 @@
 #   bash benchmarks/bench_rehearsal.sh outputs/bg_igen/train/igen/checkpoints/last/pretrained_model 20 outputs/rehearsal
 set -euo pipefail
 cd "$(dirname "$0")/.."
-CHECKPOINT=${1:?usage: bench_rehearsal.sh CHECKPOINT/pretrained_model [TRIALS] [OUT_DIR]}
+CHECKPOINT=${1:?usage: bench_rehearsal.sh CHECKPOINT/pretrained_model|scripted [TRIALS] [OUT_DIR]}
 TRIALS=${2:-20}
 OUT=${3:-outputs/rehearsal}
 HOST=${FRANKY_SIM_HOST:-127.0.0.2}
 PORT=${FRANKY_SIM_SCENE_PORT:-7711}
+POLICY=(--policy.path="$CHECKPOINT")
+[ "$CHECKPOINT" = scripted ] && POLICY=()  # the task's scripted policy (acts on what it believes)
 mkdir -p "$OUT"
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 
-.venv/bin/igen-deploy --policy.path="$CHECKPOINT" --robot.type=sim --perception.type=truth \
+.venv/bin/igen-deploy "${POLICY[@]}" --robot.type=sim --perception.type=truth \
     --trials="$TRIALS" --compare_sim=true --output="$OUT/mujoco.json"
 
 tools/franky_sim/.venv/bin/python tools/franky_sim/serve.py --hostname "$HOST" --cube 0.5 0 --scene-port "$PORT" \
@@ -27,7 +29,7 @@ trap 'kill $SERVER 2>/dev/null || true' EXIT
 for _ in $(seq 60); do grep -q READY "$OUT/franky_sim.log" && break; sleep 1; done
 grep -q READY "$OUT/franky_sim.log" || { echo "franky-sim did not start:"; cat "$OUT/franky_sim.log"; exit 1; }
 
-.venv/bin/igen-deploy --policy.path="$CHECKPOINT" --robot.type=franky --robot.host="$HOST" \
+.venv/bin/igen-deploy "${POLICY[@]}" --robot.type=franky --robot.host="$HOST" \
     --perception.type=franky_sim --perception.port="$PORT" \
     --trials="$TRIALS" --compare_sim=true --output="$OUT/franky.json"
 

@@ -3,6 +3,7 @@ and every fault ends in a stopped arm with a clear reason."""
 
 from __future__ import annotations
 
+import json
 import time
 
 import numpy as np
@@ -15,6 +16,7 @@ from igen_lerobot.evaluation.trials import evaluate
 from lerobot_robot_igen.arm import SafeArm
 from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
 from lerobot_robot_igen.belief import cube_belief
+from lerobot_robot_igen.config_arm import ArmBackendConfig
 from lerobot_robot_igen.config_deploy import (
     DeployConfig,
     RealSensePerceptionConfig,
@@ -23,7 +25,7 @@ from lerobot_robot_igen.config_deploy import (
 )
 from lerobot_robot_igen.deploy import deploy
 from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
-from lerobot_robot_igen.driver import ConnectionLostError
+from lerobot_robot_igen.driver import ConnectionLostError, DriverError
 from lerobot_robot_igen.perception.cube_pose import CubeNotVisibleError, PoseRejectedError
 from lerobot_robot_igen.pose_source import SimTruthPose
 from lerobot_robot_igen.safety import SafetyLimits
@@ -455,3 +457,39 @@ def test_rejected_estimates_reach_rerun_and_the_report(tmp_path, monkeypatch):
     assert trial["rejected_jumps"] == 4 and [r["step"] for r in trial["pose_rejections"]] == [2, 5, 8, 11]
     rows = rrd_rows(out)
     assert rows.get("/deploy/perception/rejections") == 4 and rows.get("/deploy/cube/estimate_used") == 12
+
+
+class FailsSecondReset(MujocoArm):
+    """The simulated arm that cannot be set up for its second trial (as a real arm failing to go home)."""
+
+    def reset_scene(self, seed):
+        if seed == episode_seed(SEED, 1):
+            raise DriverError("the robot refused the move home: RuntimeError: Motion planner failed (test)")
+        super().reset_scene(seed)
+
+
+def test_a_run_that_cannot_start_its_next_trial_keeps_the_trials_it_ran(tmp_path, capsys):
+    """The JSON report holds trial 1 and says why the run stopped before trial 2; the command exits non-zero."""
+    from lerobot_robot_igen.igen_deploy import deploy_main
+
+    @ArmBackendConfig.register_subclass("test_fails_second_reset")
+    class FailsSecondResetConfig(SimArmBackendConfig):
+        def make_driver(self):
+            return FailsSecondReset()
+
+    output = tmp_path / "report.json"
+    cfg = DeployConfig(
+        robot=FailsSecondResetConfig(),
+        perception=TruthPerceptionConfig(),
+        trials=3,
+        compare_sim=True,
+        output=str(output),
+    )
+    with pytest.raises(SystemExit) as exit_info:
+        deploy_main(cfg)
+    assert exit_info.value.code == 1
+    report = json.loads(output.read_text())
+    assert report["stopped"]["before_trial"] == 1 and "Motion planner failed" in report["stopped"]["reason"]
+    assert len(report["per_trial"]) == 1 and report["deployment"]["trials"] == 1
+    assert len(report["per_trial_sim"]) == 1  # igen-eval's side covers the same trials
+    assert "run stopped before trial 2 of 3" in capsys.readouterr().out

@@ -260,3 +260,24 @@ def test_igen_deploy_rehearses_igen_evals_trials_through_franky_on_franky_sim():
     # franky-sim raises no reflexes; any stop is the safety layer's, with its reason
     assert all("reflex" not in str(trial["fault"]) for trial in report["per_trial"]), report["per_trial"]
     assert report["sim"]["successes"] >= 0 and len(report["per_trial_sim"]) == 2
+
+
+def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(empty_sim):
+    """A Cartesian move home can fail outright (a plan from an awkward pose); the arm then goes home in
+    joint space, to where the first move home ended."""
+    from dataclasses import replace
+
+    arm = connected(empty_sim)
+    try:
+        arm.move_home()
+        home = arm.read_state().T_base_eef[:3, 3].copy()
+        T = arm.read_state().T_base_eef.copy()
+        T[:3, 3] += (0.05, 0.08, -0.05)
+        arm.send_target(T)
+        time.sleep(2.0)
+        assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.05
+        arm.config = replace(arm.config, home_position=(float("nan"), 0.0, 0.2))  # no Cartesian plan exists
+        arm.move_home()
+        np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)  # tolerance 5 mm
+    finally:
+        arm.disconnect()

@@ -30,7 +30,7 @@ from lerobot_robot_igen.config_deploy import (
     TruthPerceptionConfig,
 )
 from lerobot_robot_igen.deploy_loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
-from lerobot_robot_igen.driver import ArmDriver, ArmState
+from lerobot_robot_igen.driver import ArmDriver, ArmState, DriverError
 from lerobot_robot_igen.pose_source import PoseSource
 
 logger = logging.getLogger(__name__)
@@ -158,22 +158,21 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
             on_step(rec)
 
     started = time.perf_counter()
+    stopped: dict | None = None  # the run ended before its last trial: which one, and why
     try:
         with tqdm(total=cfg.trials, desc=f"deploy {cfg.policy.describe()}", unit="trial") as bar:
             for i in range(cfg.trials):
                 seed = episode_seed(cfg.seed, i)
-                if simulated:
-                    driver.reset_scene(seed)
-                    offset = driver.env.corruption  # igen-eval's trial i: same scene, same pose error
-                    judge = _sim_judge(driver)
-                elif situations is not None:
-                    offset, judge = _franky_sim_trial(driver, poses.scene, situations[i], world_from_base)
-                else:
-                    if cfg.prompt:
-                        input(f"trial {i + 1}/{cfg.trials}: place the cube, clear the workspace, press Enter ")
-                    driver.move_home()
-                    offset = cfg.corruption.sample(np.random.default_rng(seed))
-                    judge = GraspLiftJudge()
+                try:
+                    offset, judge = _start_trial(cfg, driver, poses, situations, world_from_base, i, seed)
+                except DriverError as err:
+                    # the arm cannot be set up for the next trial (it failed to go home): stop here,
+                    # and keep the trials already run in the report
+                    if not outcomes:
+                        raise
+                    logger.error("run stopped before trial %d: %s", i + 1, err)
+                    stopped = {"before_trial": i, "reason": str(err)}
+                    break
                 belief = cube_belief(offset, cfg.reveal)
                 outcome = run_episode(arm, poses, policy, belief, settings, judge, record, env_cfg.task_spec)
                 outcomes.append(outcome)
@@ -188,6 +187,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         if viz is not None:
             viz.close()
     report = {
+        "stopped": stopped,
         "policy": cfg.policy.describe(),
         "robot": cfg.robot.get_choice_name(type(cfg.robot)),
         "perception": cfg.perception.get_choice_name(type(cfg.perception)),
@@ -197,13 +197,28 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         "seconds": time.perf_counter() - started,
     }
     if sim_result is not None:
+        same_trials = sim_result.per_trial[: len(outcomes)]  # the trials the deployment ran
+        successes = sum(same_trials)
         report["sim"] = {
-            "success_rate": sim_result.success_rate,
-            "ci95": sim_result.ci95,
-            "successes": sim_result.successes,
+            "success_rate": successes / len(same_trials),
+            "ci95": wilson_interval(successes, len(same_trials)),
+            "successes": successes,
         }
-        report["per_trial_sim"] = sim_result.per_trial
+        report["per_trial_sim"] = same_trials
     return report
+
+
+def _start_trial(cfg: DeployConfig, driver, poses, situations, world_from_base, i: int, seed: int):
+    """Set up trial ``i`` (scene or arm home, cube); its pose error and success judge."""
+    if cfg.robot.simulated:
+        driver.reset_scene(seed)
+        return driver.env.corruption, _sim_judge(driver)  # igen-eval's trial i: same scene, same pose error
+    if situations is not None:
+        return _franky_sim_trial(driver, poses.scene, situations[i], world_from_base)
+    if cfg.prompt:
+        input(f"trial {i + 1}/{cfg.trials}: place the cube, clear the workspace, press Enter ")
+    driver.move_home()
+    return cfg.corruption.sample(np.random.default_rng(seed)), GraspLiftJudge()
 
 
 def deploy_logger(viz: EpisodeLogger, arm: SafeArm):

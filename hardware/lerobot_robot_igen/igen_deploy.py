@@ -43,10 +43,15 @@ def deploy_main(cfg: DeployConfig) -> dict:
         print(f"loop compute per step: {ms}")
     for fault in dep["faults"]:
         print(f"stopped: {fault}")
+    if report["stopped"]:
+        stop = report["stopped"]
+        print(f"run stopped before trial {stop['before_trial'] + 1} of {cfg.trials}: {stop['reason']}")
     if cfg.output:
         Path(cfg.output).parent.mkdir(parents=True, exist_ok=True)
         Path(cfg.output).write_text(json.dumps(report, indent=2, default=float))
         logger.info("wrote %s", cfg.output)
+    if report["stopped"]:
+        raise SystemExit(1)  # the trials that ran are in the report; the run itself did not finish
     return report
 
 

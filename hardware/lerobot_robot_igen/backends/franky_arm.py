@@ -79,6 +79,7 @@ class FrankyArm(ArmDriver):
         self._franky = None
         self._gripper_closed: bool | None = None  # the state last asked for
         self._gripper_worker: GripperWorker | None = None
+        self._home_joints: np.ndarray | None = None  # where the first Cartesian move home ended
         self._T_tcp_site = np.eye(4)
         self._T_tcp_site[:3, :3] = np.asarray(config.tcp_to_site_rotation, dtype=float)
         self._T_site_tcp = np.linalg.inv(self._T_tcp_site)
@@ -242,6 +243,22 @@ class FrankyArm(ArmDriver):
             # fail (ruckig -101); once the arm has come to rest and errors are cleared it plans
             logger.warning("%s; recovering and trying the move home once more", error)
             self._finish_last_motion()
-            self._call("the move home", self.robot.move, self._motion(T_home, factor))
+            try:
+                self._call("the move home", self.robot.move, self._motion(T_home, factor))
+            except DriverError as again:
+                if self._home_joints is None or isinstance(again, ConnectionLostError):
+                    raise
+                # a Cartesian plan can fail outright from an awkward pose (ruckig -110 seen after a
+                # policy drove the hand to the workspace corner); the joint-space path home does not
+                logger.warning("%s; moving home in joint space instead", again)
+                self._finish_last_motion()
+                joints = self._franky.JointMotion(
+                    self._franky.JointState(self._home_joints), relative_dynamics_factor=factor
+                )
+                self._call("the move home (joint space)", self.robot.move, joints)
+        if self._home_joints is None:
+            self._home_joints = self._call(
+                "a state read", lambda: np.asarray(self.robot.current_joint_positions, float)
+            )
         self.set_gripper(False)
         self.wait_gripper(2 * self.config.gripper_timeout)  # a grasp still settling, then the opening
