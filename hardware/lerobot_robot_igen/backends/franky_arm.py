@@ -11,9 +11,8 @@ targets that changes every 50 ms is exactly what trips the arm's discontinuity r
 the planner may use high accelerations and jerks (seen at factors >= 0.15 with franka-sim's
 motion-limit checks; <= 0.05 ran clean on a synthetic path, but a trained policy's own stream,
 whose deltas turn every period, still raises them: docs/benchmarks.md); velocity does not
-cause them, and capping it at 30%
-(about 0.5 m/s, the safety layer's speed limit) keeps the arm as fast as the policy was in
-simulation. The safety layer already limits each target's step, which is the filtering the
+cause them, and capping it at 30% (about 0.5 m/s, the safety layer's speed limit) keeps the arm
+as fast as the policy was in simulation. The safety layer already limits each target's step, which is the filtering the
 stream needs; no extra smoothing is added (it would add lag the policy never saw).
 
 Frames: franky reports the flange-mounted hand's TCP (``end_effector_pose``) in the base frame;
