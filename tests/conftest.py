@@ -11,6 +11,12 @@ from pathlib import Path  # noqa: E402
 # the numpy-only fake task registers itself as an igen task, so the per-task tests cover it too
 import fake_task  # noqa: E402, F401
 import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
+
+# Property tests check maths, not speed: hypothesis's 200 ms per-example deadline failed a fresh
+# clone's first examples (a cold import took 259-589 ms on a busy 2-core machine)
+settings.register_profile("igen", deadline=None)
+settings.load_profile("igen")
 
 
 @pytest.fixture()
