@@ -4,7 +4,8 @@ Run (franky-sim, made by `make setup`):
     .venv/bin/python benchmarks/bench_franky_stream.py
 Run against franka-sim's stricter motion-limit checks (its own environment, not made by setup;
 numpy 1.26 and mujoco < 3.3; its FR3 model is taken from franky-sim's, it would download one):
-    uv venv -p 3.12 /tmp/franka_sim && uv pip install -p /tmp/franka_sim franka-sim==1.1.7
+    uv venv -p "$(ls -d ~/.pyenv/versions/3.12*/bin/python3.12 | head -1)" /tmp/franka_sim  # uv cannot fetch one
+    uv pip install -p /tmp/franka_sim franka-sim==1.1.7
     .venv/bin/python benchmarks/bench_franky_stream.py --server franka-sim --python /tmp/franka_sim/bin/python
 
 Each setting streams the same path through the safety layer: 6 cm steps of a square around
