@@ -128,12 +128,11 @@ def test_a_trained_checkpoint_deploys(bc_rnn_checkpoint):
         perception=TruthPerceptionConfig(),
         trials=1,
         max_steps=30,
-        inference_threads=1,
     )
     report = deploy(cfg)
     import torch
 
-    assert torch.get_num_threads() == 1  # one inference thread: no pool stalls in the 20 Hz loop
+    assert torch.get_num_threads() == 1  # one inference thread by default: no pool stalls in the 20 Hz loop
     assert report["per_trial"][0]["steps"] == 30 or report["per_trial"][0]["success"]
     assert report["policy"] == str(bc_rnn_checkpoint)
 

@@ -59,7 +59,7 @@ def main() -> None:
             server.run_forever()
 
 
-def hand_contact_force(model, data, hand: set[int]) -> np.ndarray:
+def hand_contact_force(model, data, hand: set[int], robot_root: int) -> np.ndarray:
     """Net force [N, world = base frame] that bodies outside the robot exert on the ``hand`` bodies."""
     total = np.zeros(3)
     wrench = np.zeros(6)
@@ -67,8 +67,7 @@ def hand_contact_force(model, data, hand: set[int]) -> np.ndarray:
         contact = data.contact[i]
         body1, body2 = model.geom_bodyid[contact.geom1], model.geom_bodyid[contact.geom2]
         on_hand1, on_hand2 = body1 in hand, body2 in hand
-        robot1 = on_hand1 or model.body_rootid[body1] == model.body_rootid[next(iter(hand))]
-        robot2 = on_hand2 or model.body_rootid[body2] == model.body_rootid[next(iter(hand))]
+        robot1, robot2 = model.body_rootid[body1] == robot_root, model.body_rootid[body2] == robot_root
         if robot1 == robot2 or not (on_hand1 or on_hand2):
             continue  # robot-robot, world-world, or a contact on the arm's links (not the hand)
         mujoco.mj_contactForce(model, data, i, wrench)
@@ -86,12 +85,12 @@ def _report_hand_contact_wrench() -> None:
         model, data = robot.model, robot.data
         if model is None or data is None:
             return snapshot
-        hand = getattr(robot, "_igen_hand_bodies", None)
-        if hand is None:
+        bodies = getattr(robot, "_igen_hand_bodies", None)  # found once: this runs every 1 ms control cycle
+        if bodies is None:
             names = {model.body(i).name: i for i in range(model.nbody)}
             hand = {i for name, i in names.items() if name.endswith(HAND_BODIES) and name.startswith("robot")}
-            robot._igen_hand_bodies = hand
-        force = hand_contact_force(model, data, hand)
+            bodies = robot._igen_hand_bodies = (hand, int(model.body_rootid[next(iter(hand))]))
+        force = hand_contact_force(model, data, *bodies)
         return snapshot.replace(O_F_ext_hat_K=(*force.tolist(), 0.0, 0.0, 0.0))
 
     FrankaMujocoRobot.state = property(state)
@@ -99,7 +98,6 @@ def _report_hand_contact_wrench() -> None:
 
 def _scene_handler(sim):
     """A request handler answering "cube" and "place" for the cube of ``sim``."""
-    import mujoco
 
     class Handler(socketserver.StreamRequestHandler):
         def handle(self) -> None:

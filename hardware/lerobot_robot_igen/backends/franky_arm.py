@@ -12,8 +12,9 @@ the planner may use high accelerations and jerks (seen at factors >= 0.15 with f
 motion-limit checks; <= 0.05 ran clean on a synthetic path, but a trained policy's own stream,
 whose deltas turn every period, still raises them: docs/benchmarks.md); velocity does not
 cause them, and capping it at 30% (about 0.5 m/s, the safety layer's speed limit) keeps the arm
-as fast as the policy was in simulation. The safety layer already limits each target's step, which is the filtering the
-stream needs; no extra smoothing is added (it would add lag the policy never saw).
+as fast as the policy was in simulation. The safety layer already limits each target's step,
+which is the filtering the stream needs; no extra smoothing is added (it would add lag the
+policy never saw).
 
 Frames: franky reports the flange-mounted hand's TCP (``end_effector_pose``) in the base frame;
 the policy's end-effector frame is robosuite's grip site, the same point rotated 90 degrees
@@ -195,9 +196,12 @@ class FrankyArm(ArmDriver):
 
     def wait_gripper(self, timeout: float) -> None:
         """Block until the last gripper state asked for is reached (the move home, tests)."""
-        if self._gripper_worker is not None and not self._gripper_worker.wait_idle(timeout):
+        worker = self._gripper_worker
+        if worker is None:
+            return
+        if not worker.wait_idle(timeout):
             raise DriverError(f"the gripper did not finish its command within {timeout} s")
-        if self._gripper_worker is not None and (error := self._gripper_worker.take_error()) is not None:
+        if (error := worker.take_error()) is not None:
             raise self._fail("a gripper command", error) from error
 
     def stop(self) -> None:

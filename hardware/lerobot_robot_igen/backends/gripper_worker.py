@@ -27,7 +27,7 @@ class GripperWorker:
         self._sent: bool | None = None
         self._busy = False
         self._stopping = False
-        self.error: Exception | None = None  # the last command's failure, raised by the owner
+        self._error: Exception | None = None  # the last command's failure, raised by the owner
         self._thread = threading.Thread(target=self._run, name="gripper", daemon=True)
         self._thread.start()
 
@@ -38,7 +38,7 @@ class GripperWorker:
 
     def take_error(self) -> Exception | None:
         with self._cond:
-            error, self.error = self.error, None
+            error, self._error = self._error, None
             return error
 
     def wait_idle(self, timeout: float) -> bool:
@@ -67,7 +67,7 @@ class GripperWorker:
             except Exception as error:  # noqa: BLE001 - handed to the loop's thread, which maps it
                 logger.warning("gripper command failed: %s", error)
                 with self._cond:
-                    self.error = error
+                    self._error = error
             with self._cond:
                 self._sent = target
                 self._busy = False
