@@ -107,6 +107,32 @@ def test_rehearsal_preserves_the_policys_sim_success(block_grasp_config):
     env.close()
 
 
+def test_targets_keep_the_tasks_goal_orientation_not_a_drifted_one(sim_arm, block_grasp_config):
+    """A compliant arm's hand drifts a few degrees; the policy saw its orientation held to ~0.05 degrees
+    (quaternion std 0.0008 in training data), so every target asks for the training controller's goal
+    orientation instead of the measured one (tolerance: 1e-9)."""
+    from scipy.spatial.transform import Rotation
+
+    goal = block_grasp_config.make_action_space().rotation
+    tilted = np.array(sim_arm.env.eef_pose(), dtype=float)
+    tilted[:3, :3] = Rotation.from_euler("xz", [3.0, 2.0], degrees=True).as_matrix() @ tilted[:3, :3]
+    holding = SafeArm(sim_arm, sim_arm.world_from_base, SafetyLimits(), watchdog=False, goal_rotation=goal)
+    drifting = SafeArm(sim_arm, sim_arm.world_from_base, SafetyLimits(), watchdog=False)
+    try:
+        np.testing.assert_allclose(holding.command(tilted, np.zeros(3), False, 0.05)[:3, :3], goal, atol=1e-9)
+        kept = drifting.command(tilted, np.zeros(3), False, 0.05)[:3, :3]
+        np.testing.assert_allclose(kept, tilted[:3, :3], atol=1e-9)
+    finally:
+        holding.close()
+        drifting.close()
+    # and igen-deploy builds its arm that way
+    targets = []
+    cfg = DeployConfig(robot=SimArmBackendConfig(), perception=TruthPerceptionConfig(), trials=1, max_steps=20)
+    deploy(cfg, on_step=lambda rec: targets.append(rec.target[:3, :3]))
+    assert len(targets) == 20
+    np.testing.assert_allclose(np.stack(targets), np.broadcast_to(goal, (20, 3, 3)), atol=1e-9)
+
+
 def test_rendered_camera_and_icp_in_the_loop():
     """A simulated D415 through the real ICP estimator drives a successful grasp."""
     from lerobot_robot_igen.config_deploy import RenderedPerceptionConfig

@@ -37,8 +37,12 @@ class SafeArm:
         max_delta: float = 0.03,
         refuse_delta: float = 0.10,
         watchdog: bool = True,
+        goal_rotation: np.ndarray | None = None,
     ) -> None:
         self.driver = driver
+        # the orientation every target asks for (task frame), as the training controller's goal does;
+        # None keeps the measured one, which lets any drift of a compliant arm stand uncorrected
+        self.goal_rotation = None if goal_rotation is None else np.asarray(goal_rotation, dtype=float)
         self.T_world_base = np.asarray(world_from_base, dtype=float)
         self.T_base_world = np.linalg.inv(self.T_world_base)
         self.guard = SafetyGuard(limits or SafetyLimits())
@@ -80,7 +84,8 @@ class SafeArm:
         """Move by ``delta`` [m, task frame] from ``T_world_eef`` this period; returns the sent task-frame target.
 
         The delta is clipped to ``max_delta`` per axis, as the simulator the policy was trained in
-        clips it. A delta beyond ``refuse_delta`` (no trained policy outputs that: a wrong
+        clips it. The target's orientation is ``goal_rotation`` when set (the training controller's
+        fixed goal), else the measured one. A delta beyond ``refuse_delta`` (no trained policy outputs that: a wrong
         checkpoint or normalisation), a non-finite one, or a target far outside the workspace
         stops the arm and raises :class:`SafetyViolationError`.
         """
@@ -104,6 +109,8 @@ class SafeArm:
         if not np.allclose(np.clip(wanted, self.guard.limits.workspace_min, self.guard.limits.workspace_max), wanted):
             self.clamped_targets += 1
         target = np.array(T_world_eef, dtype=float)
+        if self.goal_rotation is not None:
+            target[:3, :3] = self.goal_rotation
         target[:3, 3] = target_pos
         try:
             with self._lock:

@@ -126,7 +126,9 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
     driver.connect()
     simulated = cfg.robot.simulated
     world_from_base = driver.world_from_base if driver.world_from_base is not None else cfg.real_world_from_base()
-    arm = SafeArm(driver, world_from_base, cfg.safety)
+    # targets keep the task's goal orientation, as its training controller's goal did: the policy saw
+    # that orientation held within a fraction of a degree, and reads a drifted one as a new situation
+    arm = SafeArm(driver, world_from_base, cfg.safety, goal_rotation=env_cfg.make_action_space().rotation)
     try:
         poses = make_pose_source(cfg, driver)
     except BaseException:  # no camera: leave the arm stopped and the connection closed
