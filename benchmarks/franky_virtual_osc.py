@@ -10,21 +10,23 @@ the virtual arm is pulled to within ``max_lead`` of it, which bounds the contact
 (docs/benchmarks.md, "The trained policy through the franky driver stack"):
 
     .venv/bin/python benchmarks/bench_step_response.py --backend franky --virtual-osc --out outputs/step/impedance.json
-    .venv/bin/python benchmarks/franky_virtual_osc.py CHECKPOINT|scripted TRIALS OUT.json   # franky-sim at 127.0.0.2
+    .venv/bin/python benchmarks/franky_virtual_osc.py --policy CHECKPOINT|scripted --trials 6 --out OUT.json
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 import threading
 import time
 
 import numpy as np
 
+from lerobot_env_igen.osc import OscGains
 from lerobot_robot_igen.backends import franky_arm
 
-KP = 150.0  # the training controller's gain [1/s^2], mass-normalised
-KD = 2.0 * np.sqrt(KP)  # critical damping
+_GAINS = OscGains()  # the training controller's, mass-normalised
+KP = _GAINS.kp_pos  # [1/s^2]
+KD = 2.0 * np.sqrt(KP) * _GAINS.damping_ratio
 STIFFNESS = 5000.0  # [N/m] the tracker's, stiff enough that a few N of model error cost ~1 mm
 ROTATIONAL_STIFFNESS = 400.0  # [Nm/rad] holds the hand's orientation to ~0.2 degrees
 MASS = 3.0  # [kg] task-space inertia assumed for the tracker's critical damping
@@ -135,17 +137,23 @@ def main() -> None:
     from lerobot_robot_igen.config_deploy import DeployConfig, FrankySimPerceptionConfig
     from lerobot_robot_igen.deploy import deploy
 
-    policy, trials, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+    parser = argparse.ArgumentParser(description="igen-deploy on franky-sim through this tracker")
+    parser.add_argument("--policy", required=True, help="a checkpoint's pretrained_model folder, or 'scripted'")
+    parser.add_argument("--trials", type=int, default=6)
+    parser.add_argument("--out", required=True, help="the JSON report")
+    parser.add_argument("--host", default="127.0.0.2", help="franky-sim's address")
+    parser.add_argument("--scene-port", type=int, default=7711, help="franky-sim's scene channel (serve.py)")
+    args = parser.parse_args()
     install()
     cfg = DeployConfig(
-        robot=FrankyArmConfig(host="127.0.0.2"),
-        perception=FrankySimPerceptionConfig(port=7711),
-        trials=trials,
-        policy=PolicySourceConfig(path=None if policy == "scripted" else policy),
-        output=out,
+        robot=FrankyArmConfig(host=args.host),
+        perception=FrankySimPerceptionConfig(port=args.scene_port),
+        trials=args.trials,
+        policy=PolicySourceConfig(path=None if args.policy == "scripted" else args.policy),
+        output=args.out,
     )
     report = deploy(cfg)
-    print(f"{report['deployment']['successes']}/{trials}", [t["revealed_at"] for t in report["per_trial"]])
+    print(f"{report['deployment']['successes']}/{args.trials}", [t["revealed_at"] for t in report["per_trial"]])
 
 
 if __name__ == "__main__":

@@ -85,9 +85,9 @@ class SafeArm:
 
         The delta is clipped to ``max_delta`` per axis, as the simulator the policy was trained in
         clips it. The target's orientation is ``goal_rotation`` when set (the training controller's
-        fixed goal), else the measured one. A delta beyond ``refuse_delta`` (no trained policy outputs that: a wrong
-        checkpoint or normalisation), a non-finite one, or a target far outside the workspace
-        stops the arm and raises :class:`SafetyViolationError`.
+        fixed goal), else the measured one. A delta beyond ``refuse_delta`` (no trained policy
+        outputs that: a wrong checkpoint or normalisation), a non-finite one, or a target far
+        outside the workspace stops the arm and raises :class:`SafetyViolationError`.
         """
         if self.fault is not None:
             raise ArmFaultError(f"the arm was stopped ({self.fault}); it takes no commands until re-armed")
