@@ -31,6 +31,7 @@ def main() -> None:
     parser.add_argument("--python", required=True, help="franka-sim's interpreter")
     parser.add_argument("--trials", type=int, default=10)
     parser.add_argument("--max_steps", type=int, default=200)
+    parser.add_argument("--controller", default="trajectory", help="the franky backend's (FrankyArmConfig)")
     args = parser.parse_args()
 
     import torch
@@ -62,9 +63,10 @@ def main() -> None:
     server = start_server("franka-sim", args.python, host)
     results = []
     try:
-        arm = FrankyArm(FrankyArmConfig(host=host))
+        arm = FrankyArm(FrankyArmConfig(host=host, controller=args.controller))
         arm.connect()
-        safe = SafeArm(arm, deploy_cfg.real_world_from_base(), deploy_cfg.safety)
+        goal = env_cfg.make_action_space().rotation  # as igen-deploy builds its arm
+        safe = SafeArm(arm, deploy_cfg.real_world_from_base(), deploy_cfg.safety, goal_rotation=goal)
         try:
             for i, (T_world_cube, corruption) in enumerate(situations):
                 arm.move_home()

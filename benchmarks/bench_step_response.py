@@ -10,6 +10,8 @@ against franky-sim, and prints the hand's displacement per period side by side.
     .venv/bin/python benchmarks/bench_step_response.py --backend sim --out outputs/step/sim.json
     .venv/bin/python benchmarks/bench_step_response.py --backend franky --host 127.0.0.2 \
         --out outputs/step/franky.json   # franky-sim started as in bench_rehearsal.sh
+    .venv/bin/python benchmarks/bench_step_response.py --backend franky --controller impedance \
+        --out outputs/step/impedance.json
     .venv/bin/python benchmarks/bench_step_response.py --compare outputs/step/sim.json outputs/step/franky.json
 """
 
@@ -18,7 +20,6 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import sys
 import time
 from pathlib import Path
 
@@ -48,7 +49,7 @@ def make_driver(args: argparse.Namespace):
         return MujocoArm()
     from lerobot_robot_igen.backends.franky_arm import FrankyArmConfig
 
-    return FrankyArmConfig(host=args.host).make_driver()
+    return FrankyArmConfig(host=args.host, controller=args.controller).make_driver()
 
 
 def run_schedule(driver, deltas: np.ndarray, realtime: bool) -> dict:
@@ -90,7 +91,7 @@ def main() -> None:
     parser.add_argument("--backend", choices=("sim", "franky"))
     parser.add_argument("--host", default="127.0.0.2", help="franky-sim's address (--backend franky)")
     parser.add_argument("--out", type=Path)
-    parser.add_argument("--virtual-osc", action="store_true", help="franky_virtual_osc.py tracker")
+    parser.add_argument("--controller", default="trajectory", help="the franky backend's (FrankyArmConfig)")
     parser.add_argument("--compare", type=Path, nargs=2, metavar=("REFERENCE", "OTHER"), help="two runs side by side")
     args = parser.parse_args()
     if args.compare:
@@ -99,11 +100,6 @@ def main() -> None:
     if args.backend is None or args.out is None:
         parser.error("--backend and --out are needed to measure (or --compare REFERENCE OTHER)")
     logging.basicConfig(level=logging.INFO)
-    if args.virtual_osc:
-        sys.path.insert(0, str(Path(__file__).parent))
-        import franky_virtual_osc
-
-        franky_virtual_osc.install()
     driver = make_driver(args)
     driver.connect()
     results = {}

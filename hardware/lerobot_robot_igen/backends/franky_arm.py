@@ -1,20 +1,22 @@
 """A real Franka (FR3 or Panda) through franky-control, behind the driver protocol.
 
-How the 20 Hz stream reaches the arm: every period the loop sends an *absolute* Cartesian
-target as an asynchronous ``CartesianMotion``; franky replaces the running motion and its
-online trajectory generator (Ruckig) plans a jerk-limited path to the new target within the
-arm's limits scaled by ``relative_dynamics_factor``. Absolute, because franky's *relative*
-Cartesian motions are expressed in the end-effector frame, not the base frame the loop uses.
+How the 20 Hz stream reaches the arm depends on ``controller``:
 
-Dynamics we ship: velocity factor 0.3, acceleration and jerk factors 0.05. A stream of
-targets that changes every 50 ms is exactly what trips the arm's discontinuity reflexes when
-the planner may use high accelerations and jerks (seen at factors >= 0.15 with franka-sim's
-motion-limit checks; <= 0.05 ran clean on a synthetic path, but a trained policy's own stream,
-whose deltas turn every period, still raises them: docs/benchmarks.md); velocity does not
-cause them, and capping it at 30% (about 0.5 m/s, the safety layer's speed limit) keeps the arm
-as fast as the policy was in simulation. The safety layer already limits each target's step,
-which is the filtering the stream needs; no extra smoothing is added (it would add lag the
-policy never saw).
+* ``impedance``: each period's target is the goal of a model of the training
+  simulator's controller (``training_controller``), which franky's Cartesian impedance tracker
+  follows in torque mode (``franky_tracker``). The hand then moves per period as it did in the
+  training simulator, and torque control raises none of the motion generator's reflexes.
+* ``trajectory`` (default): every period the loop sends an *absolute* Cartesian target as an asynchronous
+  ``CartesianMotion``; franky's online trajectory generator (Ruckig) plans a jerk-limited path to
+  it within the arm's limits scaled by ``relative_dynamics_factor`` (velocity 0.3, acceleration
+  and jerk 0.05). Absolute, because franky's *relative* Cartesian motions are expressed in the
+  end-effector frame, not the base frame the loop uses. Measured (docs/benchmarks.md): it lags,
+  then coasts 1.2 cm past a stop, a trained policy fails on it, and a trained policy's own stream
+  (deltas that turn every period) trips the arm's acceleration-discontinuity reflex even at 5%
+  acceleration and jerk. On franky-sim, though, scripted motions succeed more often with it;
+  docs/benchmarks.md compares both.
+
+Moves home are always trajectory motions (a planned path, then the streaming starts afresh).
 
 Frames: franky reports the flange-mounted hand's TCP (``end_effector_pose``) in the base frame;
 the policy's end-effector frame is robosuite's grip site, the same point rotated 90 degrees
@@ -30,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from igen_lerobot.core.exceptions import ConfigError
+from lerobot_robot_igen.backends.franky_tracker import ImpedanceTracker
 from lerobot_robot_igen.backends.gripper_worker import GripperWorker
 from lerobot_robot_igen.config_arm import ArmBackendConfig
 from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError, DriverError
@@ -48,6 +52,19 @@ class FrankyArmConfig(ArmBackendConfig):
     """A Franka FR3/Panda over FCI (``--robot.host``), with its gripper."""
 
     host: str = "172.16.0.2"
+    controller: str = "trajectory"  # how targets are followed: "trajectory" or "impedance" (module docstring)
+    # impedance: the training controller's law (lerobot_env_igen.osc.OscGains: kp 150, critical damping)
+    training_kp: float = 150.0  # [1/s^2]
+    training_damping_ratio: float = 1.0
+    tracker_stiffness: float = 5000.0  # [N/m] stiff enough that a few N of model error cost about 1 mm
+    tracker_rotational_stiffness: float = 400.0  # [Nm/rad] holds the hand's orientation to about 0.2 degrees
+    # [rad] orientation error the tracker acts on at most: 8 Nm at 400 Nm/rad, under the wrist joints' 12 Nm
+    # (franka-sim refused a 2.6 degree error at the default 0.25 rad: tau_J_range_violation)
+    tracker_rotational_error_clip: float = 0.02
+    tracker_mass: float = 3.0  # [kg] task-space inertia assumed for the tracker's critical damping
+    max_lead: float = 0.005  # [m] how far the model may be ahead of a hand held back: at most 25 N of push
+    stream_period: float = 0.002  # [s] how often the model's state is sent to the tracker
+    # trajectory: franky's relative dynamics factors
     velocity_factor: float = 0.3  # of the arm's limits, for the streamed motions (see module docstring)
     acceleration_factor: float = 0.05
     jerk_factor: float = 0.05
@@ -63,6 +80,20 @@ class FrankyArmConfig(ArmBackendConfig):
     gripper_timeout: float = 5.0  # [s] the longest a gripper command may take (waited for at home and disconnect)
     settle_timeout: float = 3.0  # [s] the longest the move home waits for the last target's motion
     tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
+
+    def __post_init__(self) -> None:
+        if self.controller not in ("impedance", "trajectory"):
+            raise ConfigError(f"--robot.controller must be 'impedance' or 'trajectory', got {self.controller!r}")
+        for name in (
+            "tracker_stiffness",
+            "tracker_rotational_stiffness",
+            "tracker_rotational_error_clip",
+            "tracker_mass",
+            "max_lead",
+            "stream_period",
+        ):
+            if not getattr(self, name) > 0:
+                raise ConfigError(f"--robot.{name} must be > 0, got {getattr(self, name)}")
 
     def make_driver(self) -> ArmDriver:
         return FrankyArm(self)
@@ -81,6 +112,7 @@ class FrankyArm(ArmDriver):
         self._franky = None
         self._gripper_closed: bool | None = None  # the state last asked for
         self._gripper_worker: GripperWorker | None = None
+        self._tracker: ImpedanceTracker | None = None
         self._home_joints: np.ndarray | None = None  # where the first Cartesian move home ended
         self._T_tcp_site = np.eye(4)
         self._T_tcp_site[:3, :3] = np.asarray(config.tcp_to_site_rotation, dtype=float)
@@ -130,6 +162,8 @@ class FrankyArm(ArmDriver):
             ),
             open_=lambda: gripper.move(cfg.open_width, cfg.gripper_speed),
         )
+        if cfg.controller == "impedance":
+            self._tracker = ImpedanceTracker(robot, franky, cfg, self._call)
         self._call("error recovery", robot.recover_from_errors)
         robot.relative_dynamics_factor = franky.RelativeDynamicsFactor(
             cfg.velocity_factor, cfg.acceleration_factor, cfg.jerk_factor
@@ -180,6 +214,9 @@ class FrankyArm(ArmDriver):
         return franky.CartesianMotion(target, franky.ReferenceType.Absolute, relative_dynamics_factor=factor)
 
     def send_target(self, T_base_eef: np.ndarray) -> None:
+        if self._tracker is not None:
+            self._tracker.send(np.asarray(T_base_eef, dtype=float) @ self._T_site_tcp)
+            return
         motion = self._motion(T_base_eef)
         self._call("a Cartesian target", self.robot.move, motion, asynchronous=True)
 
@@ -207,12 +244,22 @@ class FrankyArm(ArmDriver):
     def stop(self) -> None:
         if self.robot is None:
             return
+        tracking = self._tracker is not None and self._tracker.end()
         try:
             self._call("a stop", self.robot.stop)
         except ConnectionLostError as error:
             # The arm's controller stops by itself when the stream of commands breaks off
             # (libfranka's communication constraints); nothing more can be sent to it.
             logger.warning("cannot send stop: %s; the arm halts on its own when it loses the connection", error)
+            return
+        if tracking:
+            # a torque motion ends at the next cycle after the stop; wait for it, or the connection (and a
+            # new one to the same arm) stays held by a motion still running
+            try:
+                self.robot.join_motion(self.config.settle_timeout)
+            except Exception as error:  # noqa: BLE001 - the stop preempts it: that is how it ends
+                if "preempted" not in str(error):
+                    raise self._fail("the stop", error) from error
 
     def recover(self) -> None:
         self._call("error recovery", self.robot.recover_from_errors)
@@ -223,13 +270,18 @@ class FrankyArm(ArmDriver):
         A motion's failure surfaces at the next command: the move home would inherit the last
         target's error instead of starting from a still, error-free arm.
         """
+        if self._tracker is not None and self._tracker.end():
+            self._call("a stop", self.robot.stop)  # the tracking motion never ends by itself
         try:
             self.robot.join_motion(self.config.settle_timeout)
         except Exception as error:  # noqa: BLE001 - any franky error of the finished motion
             failure = self._fail("the last target", error)
             if isinstance(failure, ConnectionLostError):
                 raise failure from error
-            logger.warning("the last target before the move home ended with %s: %s", type(error).__name__, error)
+            if "preempted" in str(error):  # the stop above (or a newer motion) ended it, as intended
+                logger.debug("the last motion was preempted before the move home")
+            else:
+                logger.warning("the last target before the move home ended with %s: %s", type(error).__name__, error)
         self._call("error recovery", self.robot.recover_from_errors)
 
     def move_home(self) -> None:
