@@ -17,6 +17,7 @@ import json
 import os
 import signal
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -43,8 +44,8 @@ def main() -> None:
     from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
     from lerobot_robot_igen.belief import cube_belief
     from lerobot_robot_igen.config_deploy import DeployConfig
-    from lerobot_robot_igen.deploy import _trial_situations
-    from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
+    from lerobot_robot_igen.deploy import _trial_situations, loop_settings
+    from lerobot_robot_igen.deploy_loop import run_episode
     from lerobot_robot_igen.pose_source import PoseReading, PoseSource
 
     class FixedCube(PoseSource):
@@ -57,7 +58,7 @@ def main() -> None:
     torch.set_num_threads(1)
     env_cfg = BlockGraspEnvConfig()
     policy = make_base_policy(PolicySourceConfig(path=args.checkpoint), env_cfg)
-    deploy_cfg = DeployConfig(trials=args.trials)
+    deploy_cfg = DeployConfig(trials=args.trials, max_steps=args.max_steps)
     situations = _trial_situations(env_cfg, deploy_cfg)
     host = "127.0.0.1"  # franka-sim's fixed address
     server = start_server("franka-sim", args.python, host)
@@ -77,7 +78,7 @@ def main() -> None:
                     FixedCube(T_base_cube),
                     policy,
                     cube_belief(offset, Reveal.FULL),
-                    LoopSettings(max_steps=args.max_steps, realtime=True),
+                    replace(loop_settings(deploy_cfg, goal), realtime=True),
                     judge=lambda state, action: False,
                     spec=env_cfg.task_spec,
                 )

@@ -133,6 +133,38 @@ def test_targets_keep_the_tasks_goal_orientation_not_a_drifted_one(sim_arm, bloc
     np.testing.assert_allclose(np.stack(targets), np.broadcast_to(goal, (20, 3, 3)), atol=1e-9)
 
 
+def test_the_policy_observes_the_goal_orientation_unless_told_to_observe_the_measured_one(block_grasp_config):
+    """The training arm's hand tilts a few tenths of a degree while it moves; a policy can learn to read
+    that tilt, which no other arm reproduces. By default the policy is told the orientation the
+    controller holds; --hand_orientation=measured passes the arm's reading (tolerance 1e-6)."""
+    from igen_lerobot.core.observation import robot_state
+
+    goal = block_grasp_config.make_action_space().rotation
+    goal_quat = robot_state(np.block([[goal, np.zeros((3, 1))], [np.zeros((1, 3)), np.ones((1, 1))]]), 0.08)[3:7]
+    seen = {}
+    for mode in ("goal", "measured"):
+        rows = seen[mode] = []
+        cfg = DeployConfig(
+            robot=SimArmBackendConfig(),
+            perception=TruthPerceptionConfig(),
+            trials=1,
+            max_steps=30,
+            hand_orientation=mode,
+        )
+        report = deploy(cfg, on_step=lambda rec, rows=rows: rows.append(rec))
+        assert report["hand_orientation"] == mode
+    measured = np.stack([robot_state(rec.T_world_eef, 0.08)[3:7] for rec in seen["goal"]])
+    assert np.abs(measured - goal_quat).max() > 1e-4  # the arm does tilt, so the choice matters
+    observed = np.stack([rec.observation["observation.state"][3:7] for rec in seen["goal"]])
+    np.testing.assert_allclose(observed, np.broadcast_to(goal_quat, observed.shape), atol=1e-6)
+    for rec in seen["measured"]:
+        np.testing.assert_allclose(
+            rec.observation["observation.state"][3:7], robot_state(rec.T_world_eef, 0.08)[3:7], atol=1e-6
+        )
+    with pytest.raises(ConfigError, match="--hand_orientation='tilted'"):
+        DeployConfig(hand_orientation="tilted")
+
+
 def test_rendered_camera_and_icp_in_the_loop():
     """A simulated D415 through the real ICP estimator drives a successful grasp."""
     from lerobot_robot_igen.config_deploy import RenderedPerceptionConfig

@@ -102,6 +102,19 @@ def _summary(name: str, outcomes: list[EpisodeOutcome]) -> dict:
     }
 
 
+def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray) -> LoopSettings:
+    """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame)."""
+    return LoopSettings(
+        fps=cfg.fps,
+        max_steps=cfg.max_steps,
+        contact_force_threshold=cfg.contact_force_threshold,
+        max_pose_age=cfg.max_pose_age,
+        realtime=bool(cfg.realtime),
+        pose_gate=cfg.pose_gate,
+        observed_hand_rotation=goal_rotation if cfg.hand_orientation == "goal" else None,
+    )
+
+
 def deploy(cfg: DeployConfig, on_step=None) -> dict:
     """Run ``cfg.trials`` episodes; returns (and optionally writes) a JSON-able report."""
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
@@ -128,21 +141,15 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
     world_from_base = driver.world_from_base if driver.world_from_base is not None else cfg.real_world_from_base()
     # targets keep the task's goal orientation, as its training controller's goal did: the policy saw
     # that orientation held within a fraction of a degree, and reads a drifted one as a new situation
-    arm = SafeArm(driver, world_from_base, cfg.safety, goal_rotation=env_cfg.make_action_space().rotation)
+    goal_rotation = env_cfg.make_action_space().rotation
+    arm = SafeArm(driver, world_from_base, cfg.safety, goal_rotation=goal_rotation)
     try:
         poses = make_pose_source(cfg, driver)
     except BaseException:  # no camera: leave the arm stopped and the connection closed
         arm.close()
         driver.disconnect()
         raise
-    settings = LoopSettings(
-        fps=cfg.fps,
-        max_steps=cfg.max_steps,
-        contact_force_threshold=cfg.contact_force_threshold,
-        max_pose_age=cfg.max_pose_age,
-        realtime=bool(cfg.realtime),
-        pose_gate=cfg.pose_gate,
-    )
+    settings = loop_settings(cfg, goal_rotation)
     outcomes: list[EpisodeOutcome] = []
     step_times: list[float] = []
     period_times: list[float] = []
@@ -193,6 +200,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         "policy": cfg.policy.describe(),
         "robot": cfg.robot.get_choice_name(type(cfg.robot)),
         "perception": cfg.perception.get_choice_name(type(cfg.perception)),
+        "hand_orientation": cfg.hand_orientation,
         "deployment": _summary("deployment", outcomes),
         "per_trial": [o.to_json() for o in outcomes],
         "loop": {"step": timing_stats(step_times), "period": timing_stats(period_times)},

@@ -57,6 +57,8 @@ class LoopSettings:
     max_pose_age: float = 0.5  # [s] act on a previous cube estimate for at most this long
     realtime: bool = True  # pace to the wall clock (real arms); False: as fast as the sim steps
     pose_gate: PoseGateSettings = field(default_factory=PoseGateSettings)
+    # the hand orientation the policy observes (task frame) instead of the measured one; None: measured
+    observed_hand_rotation: np.ndarray | None = None
 
 
 @dataclass
@@ -178,7 +180,11 @@ def run_episode(
             if belief.revealed and outcome.revealed_at is None:
                 outcome.revealed_at = step
             believed = {spec.corrupted_object: belief.believed_pose(T_world_cube)}
-            observation = build_observation(spec, T_world_eef, state.gripper_width, believed, belief)
+            T_observed = T_world_eef
+            if settings.observed_hand_rotation is not None:
+                T_observed = T_world_eef.copy()
+                T_observed[:3, :3] = settings.observed_hand_rotation
+            observation = build_observation(spec, T_observed, state.gripper_width, believed, belief)
 
             start = time.perf_counter()
             action = np.asarray(policy.act(observation), dtype=float)

@@ -32,6 +32,18 @@ import numpy as np
 from franky_sim.mujoco_simulator import FrankaMujocoRobot, MujocoSimulator
 
 HAND_BODIES = ("hand", "left_finger", "right_finger")  # after franky-sim's robot prefix
+# The Block Grasp cube as the training simulator builds it (robosuite's BoxObject defaults:
+# density 1000, so 0.125 kg; its friction and contact softness), so the fingers push, tip and
+# hold it as they did in training.
+TRAINING_CUBE = {
+    "type": "box",
+    "size": "0.025 0.025 0.025",
+    "rgba": "1 0 0 1",
+    "mass": "0.125",
+    "friction": "1 0.005 0.0001",
+    "solref": "0.02 1",
+    "solimp": "0.9 0.95 0.001",
+}
 
 
 def main() -> None:
@@ -47,8 +59,7 @@ def main() -> None:
             x, y = args.cube
             cube = ET.SubElement(sim.worldbody, "body", name="cube", pos=f"{x} {y} 0.025")
             ET.SubElement(cube, "freejoint", name="cube_joint")
-            box = {"type": "box", "size": "0.025 0.025 0.025", "rgba": "1 0 0 1", "mass": "0.1"}
-            ET.SubElement(cube, "geom", friction="1.5 0.01 0.001", **box)
+            ET.SubElement(cube, "geom", **TRAINING_CUBE)
         sim.add_robot()
         with franky_sim.SimulationServer(sim, hostname_candidates=[args.hostname]) as server:
             if args.scene_port is not None and args.cube is not None:
