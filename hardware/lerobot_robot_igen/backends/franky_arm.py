@@ -183,6 +183,9 @@ class FrankyArm(ArmDriver):
             if not self._gripper_worker.close(self.config.gripper_timeout):
                 _STILL_RUNNING.append((self.gripper, self._gripper_worker))
             self._gripper_worker = None
+        # nothing may keep the franky.Robot alive: its connection closes only when it is freed, and the
+        # arm (franky-sim too) takes one client at a time, so a kept reference blocks the next connect()
+        self._tracker = None
         self.robot = self.gripper = None
 
     @property
