@@ -106,3 +106,54 @@ def test_igen_eval_bad_input_names_the_fix(tmp_path):
         env=ENV,
     )
     assert both.returncode == 2 and "not both" in both.stderr
+
+
+class _Recording:
+    """The policy under test, keeping every action it returns."""
+
+    def __init__(self, policy) -> None:
+        self.policy, self.actions = policy, []
+
+    def reset(self) -> None:
+        self.policy.reset()
+
+    def seed(self, seed: int) -> None:
+        self.policy.seed(seed)
+
+    def act(self, observation):
+        action = self.policy.act(observation)
+        self.actions.append(action)
+        return action
+
+
+def test_a_sampling_checkpoints_trial_is_the_same_whatever_ran_before(bc_rnn_checkpoint, block_grasp_config):
+    """BC-RNN's mixture head draws a mode every step from torch's generator; each trial seeds it from its
+    own seed, so trial i repeats exactly (tolerance 0) after other trials or in another process (a
+    rehearsal's trial i is igen-eval's trial i)."""
+    import numpy as np
+    import torch
+
+    from igen_lerobot.evaluation.trials import rollout
+    from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+    policy = _Recording(make_base_policy(PolicySourceConfig(path=str(bc_rnn_checkpoint)), block_grasp_config))
+    env = block_grasp_config.make_task_env()
+    try:
+        observation = env.reset(7)
+        drawn = []
+        for generator_seed in range(5):  # the policy does sample: unseeded, trials would differ
+            torch.manual_seed(generator_seed)
+            policy.reset()
+            drawn.append(policy.act(observation))
+        assert any(not np.array_equal(drawn[0], other) for other in drawn[1:])
+
+        policy.actions.clear()
+        rollout(env, policy, seed=7, max_steps=15)
+        first = np.stack(policy.actions)
+        torch.rand(1000)  # whatever else used the generator in between
+        rollout(env, policy, seed=8, max_steps=15)
+        policy.actions.clear()
+        rollout(env, policy, seed=7, max_steps=15)
+        np.testing.assert_array_equal(np.stack(policy.actions), first)
+    finally:
+        env.close()

@@ -183,7 +183,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
                     stopped = {"before_trial": i, "reason": str(err)}
                     break
                 belief = cube_belief(offset, cfg.reveal)
-                outcome = run_episode(arm, poses, policy, belief, settings, judge, record, env_cfg.task_spec)
+                outcome = run_episode(arm, poses, policy, belief, settings, judge, record, env_cfg.task_spec, seed)
                 outcomes.append(outcome)
                 if not simulated:
                     driver.set_gripper(False)

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from igen_lerobot.core.agents import Policy
+from igen_lerobot.core.agents import Policy, seed_policy
 from igen_lerobot.core.belief import ObjectBelief
 from igen_lerobot.core.exceptions import IgenError
 from igen_lerobot.core.observation import observation as build_observation
@@ -125,16 +125,20 @@ def run_episode(
     judge: Callable[[ArmState, np.ndarray], bool],
     on_step: Callable[[StepRecord], None] | None = None,
     spec: TaskSpec = BLOCK_GRASP_SPEC,
+    seed: int | None = None,
 ) -> EpisodeOutcome:
     """Run one episode; the arm is stopped (not disconnected) whatever happens.
 
     ``belief`` is the core's belief about the cube (the same model the simulator keeps);
-    ``spec`` gives the observation layout the policy was trained on.
+    ``spec`` gives the observation layout the policy was trained on; ``seed`` (the trial's) fixes
+    the policy's sampling, as igen-eval's trial with that seed does.
     """
     period = 1.0 / settings.fps
     max_stale = settings.max_pose_age
     pacer = RatePacer(settings.fps if settings.realtime else None)
     policy.reset()
+    if seed is not None:
+        seed_policy(policy, seed)
     arm.rearm()
     times: dict[str, list[float]] = {"perception": [], "policy": [], "command": [], "step": [], "period": []}
     outcome = EpisodeOutcome(success=False, steps=0)

@@ -13,7 +13,7 @@ import numpy as np
 
 from igen_lerobot.core.task import TaskEnv
 
-__all__ = ["Policy", "Operator", "TakeoverOperator"]
+__all__ = ["Policy", "Operator", "TakeoverOperator", "seed_policy"]
 
 
 @runtime_checkable
@@ -25,6 +25,18 @@ class Policy(Protocol):
 
     def act(self, observation: dict[str, np.ndarray]) -> np.ndarray:
         """Action for one step from ``observation.state`` / ``observation.environment_state``."""
+
+
+def seed_policy(policy: Policy, seed: int) -> None:
+    """Fix the sampling a learned policy does during one trial from the trial's own seed.
+
+    BC-RNN's mixture head draws a mode every step, a diffusion policy its noise: seeded per trial,
+    trial i rolls out the same in every process and in any order (igen-eval, a rehearsal's trial i,
+    a resumed generation). Policies without sampling (scripted ones) have no ``seed`` method.
+    """
+    seeder = getattr(policy, "seed", None)
+    if callable(seeder):
+        seeder(seed)
 
 
 class Operator(abc.ABC):

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 
 from tqdm import tqdm
 
-from igen_lerobot.core.agents import Policy
+from igen_lerobot.core.agents import Policy, seed_policy
 from igen_lerobot.core.cameras import CameraConfig, image_key, render_images
 from igen_lerobot.core.episode import Episode
 from igen_lerobot.core.exceptions import ConfigError
@@ -77,6 +77,7 @@ def rollout(
 
     obs = observed(env.reset(seed))
     policy.reset()
+    seed_policy(policy, seed)
     for step in range(1, max_steps + 1):
         action = policy.act(obs)
         if recorder is not None:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from igen_lerobot.core.agents import Policy
+from igen_lerobot.core.agents import Policy, seed_policy
 from igen_lerobot.core.episode import EpisodeKind
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.recorder import EpisodeRecorder
@@ -106,6 +106,7 @@ def generate_intervention(
     else:
         obs = env.reset(seed)
         policy.reset()
+        seed_policy(policy, seed)
     first_mistake: int | None = None
     recoveries: list[int] = []
     success, steps = False, 0

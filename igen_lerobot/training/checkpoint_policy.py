@@ -99,6 +99,10 @@ class LeRobotCheckpointPolicy:
     def reset(self) -> None:
         self.policy.reset()
 
+    def seed(self, seed: int) -> None:
+        """Seed torch's generator, which LeRobot's policies sample from (see ``core.agents.seed_policy``)."""
+        self._torch.manual_seed(seed)
+
     def act(self, observation: dict[str, np.ndarray]) -> np.ndarray:
         torch = self._torch
         batch = {

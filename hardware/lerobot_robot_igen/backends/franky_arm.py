@@ -2,19 +2,21 @@
 
 How the 20 Hz stream reaches the arm depends on ``controller``:
 
-* ``impedance``: each period's target is the goal of a model of the training
+* ``impedance`` (default): each period's target is the goal of a model of the training
   simulator's controller (``training_controller``), which franky's Cartesian impedance tracker
   follows in torque mode (``franky_tracker``). The hand then moves per period as it did in the
-  training simulator, and torque control raises none of the motion generator's reflexes.
-* ``trajectory`` (default): every period the loop sends an *absolute* Cartesian target as an asynchronous
+  training simulator, and torque control raises none of the motion generator's reflexes. The
+  tracker's stiffness is 3000 N/m, the top of the range franky's predecessor documents for its
+  impedance motions; the model is kept within ``max_lead`` of the hand and the tracker's
+  position error is clipped, which bounds the push on an obstacle.
+* ``trajectory``: every period the loop sends an *absolute* Cartesian target as an asynchronous
   ``CartesianMotion``; franky's online trajectory generator (Ruckig) plans a jerk-limited path to
   it within the arm's limits scaled by ``relative_dynamics_factor`` (velocity 0.3, acceleration
   and jerk 0.05). Absolute, because franky's *relative* Cartesian motions are expressed in the
   end-effector frame, not the base frame the loop uses. Measured (docs/benchmarks.md): it lags,
   then coasts 1.2 cm past a stop, a trained policy fails on it, and a trained policy's own stream
   (deltas that turn every period) trips the arm's acceleration-discontinuity reflex even at 5%
-  acceleration and jerk. On franky-sim, though, scripted motions succeed more often with it;
-  docs/benchmarks.md compares both.
+  acceleration and jerk. Scripted motions, whose targets change smoothly, run well on it.
 
 Moves home are always trajectory motions (a planned path, then the streaming starts afresh).
 
@@ -52,17 +54,20 @@ class FrankyArmConfig(ArmBackendConfig):
     """A Franka FR3/Panda over FCI (``--robot.host``), with its gripper."""
 
     host: str = "172.16.0.2"
-    controller: str = "trajectory"  # how targets are followed: "trajectory" or "impedance" (module docstring)
+    controller: str = "impedance"  # how targets are followed: "impedance" or "trajectory" (module docstring)
     # impedance: the training controller's law (lerobot_env_igen.osc.OscGains: kp 150, critical damping)
     training_kp: float = 150.0  # [1/s^2]
     training_damping_ratio: float = 1.0
-    tracker_stiffness: float = 5000.0  # [N/m] stiff enough that a few N of model error cost about 1 mm
+    tracker_stiffness: float = 3000.0  # [N/m] a few N of model error cost about 1 mm
     tracker_rotational_stiffness: float = 400.0  # [Nm/rad] holds the hand's orientation to about 0.2 degrees
     # [rad] orientation error the tracker acts on at most: 8 Nm at 400 Nm/rad, under the wrist joints' 12 Nm
     # (franka-sim refused a 2.6 degree error at the default 0.25 rad: tau_J_range_violation)
     tracker_rotational_error_clip: float = 0.02
     tracker_mass: float = 3.0  # [kg] task-space inertia assumed for the tracker's critical damping
-    max_lead: float = 0.005  # [m] how far the model may be ahead of a hand held back: at most 25 N of push
+    max_lead: float = 0.005  # [m] how far the model may be ahead of a hand held back: 15 N of push
+    # [m] position error the tracker acts on at most (franky's default is 0.1 m): 30 N at 3000 N/m, even
+    # when the model runs ahead within a period; free motion lags the model by 1-3 mm
+    tracker_translational_error_clip: float = 0.01
     stream_period: float = 0.002  # [s] how often the model's state is sent to the tracker
     # trajectory: franky's relative dynamics factors
     velocity_factor: float = 0.3  # of the arm's limits, for the streamed motions (see module docstring)
@@ -88,6 +93,7 @@ class FrankyArmConfig(ArmBackendConfig):
             "tracker_stiffness",
             "tracker_rotational_stiffness",
             "tracker_rotational_error_clip",
+            "tracker_translational_error_clip",
             "tracker_mass",
             "max_lead",
             "stream_period",

@@ -66,6 +66,7 @@ class ImpedanceTracker:
             translational_stiffness=k,
             rotational_stiffness=kr,
             rotational_error_clip=np.full(3, cfg.tracker_rotational_error_clip),
+            translational_error_clip=np.full(3, cfg.tracker_translational_error_clip),
             gains_time_constant=0.005,
         )
         motion.set_gains(
