@@ -32,7 +32,7 @@ def main() -> None:
     parser.add_argument("--python", required=True, help="franka-sim's interpreter")
     parser.add_argument("--trials", type=int, default=10)
     parser.add_argument("--max_steps", type=int, default=200)
-    parser.add_argument("--controller", default="trajectory", help="the franky backend's (FrankyArmConfig)")
+    parser.add_argument("--controller", help="the franky backend's (default: FrankyArmConfig's)")
     args = parser.parse_args()
 
     import torch
@@ -64,7 +64,8 @@ def main() -> None:
     server = start_server("franka-sim", args.python, host)
     results = []
     try:
-        arm = FrankyArm(FrankyArmConfig(host=host, controller=args.controller))
+        controller = {"controller": args.controller} if args.controller else {}
+        arm = FrankyArm(FrankyArmConfig(host=host, **controller))
         arm.connect()
         goal = env_cfg.make_action_space().rotation  # as igen-deploy builds its arm
         safe = SafeArm(arm, deploy_cfg.real_world_from_base(), deploy_cfg.safety, goal_rotation=goal)

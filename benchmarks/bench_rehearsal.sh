@@ -7,7 +7,7 @@
 # Both run --compare_sim=true: igen-eval's own rollout of the same checkpoint on the same trials.
 #
 #   bash benchmarks/bench_rehearsal.sh outputs/bg_igen/train/igen/checkpoints/last/pretrained_model 20 outputs/rehearsal
-# FRANKY_CONTROLLER=impedance picks the franky backend's controller (default: trajectory).
+# FRANKY_CONTROLLER=trajectory|impedance picks the franky backend's controller (default: the backend's own).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 CHECKPOINT=${1:?usage: bench_rehearsal.sh CHECKPOINT/pretrained_model|scripted [TRIALS] [OUT_DIR]}
@@ -15,7 +15,8 @@ TRIALS=${2:-20}
 OUT=${3:-outputs/rehearsal}
 HOST=${FRANKY_SIM_HOST:-127.0.0.2}
 PORT=${FRANKY_SIM_SCENE_PORT:-7711}
-CONTROLLER=${FRANKY_CONTROLLER:-trajectory}
+CONTROLLER=()
+[ -n "${FRANKY_CONTROLLER:-}" ] && CONTROLLER=(--robot.controller="$FRANKY_CONTROLLER")
 POLICY=(--policy.path="$CHECKPOINT")
 [ "$CHECKPOINT" = scripted ] && POLICY=()  # the task's scripted policy (acts on what it believes)
 mkdir -p "$OUT"
@@ -31,7 +32,7 @@ trap 'kill $SERVER 2>/dev/null || true' EXIT
 for _ in $(seq 60); do grep -q READY "$OUT/franky_sim.log" && break; sleep 1; done
 grep -q READY "$OUT/franky_sim.log" || { echo "franky-sim did not start:"; cat "$OUT/franky_sim.log"; exit 1; }
 
-.venv/bin/igen-deploy "${POLICY[@]}" --robot.type=franky --robot.host="$HOST" --robot.controller="$CONTROLLER" \
+.venv/bin/igen-deploy "${POLICY[@]}" --robot.type=franky --robot.host="$HOST" "${CONTROLLER[@]}" \
     --perception.type=franky_sim --perception.port="$PORT" \
     --trials="$TRIALS" --compare_sim=true --output="$OUT/franky.json"
 

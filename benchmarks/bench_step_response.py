@@ -49,7 +49,8 @@ def make_driver(args: argparse.Namespace):
         return MujocoArm()
     from lerobot_robot_igen.backends.franky_arm import FrankyArmConfig
 
-    return FrankyArmConfig(host=args.host, controller=args.controller).make_driver()
+    controller = {"controller": args.controller} if args.controller else {}
+    return FrankyArmConfig(host=args.host, **controller).make_driver()
 
 
 def run_schedule(driver, deltas: np.ndarray, realtime: bool) -> dict:
@@ -91,7 +92,7 @@ def main() -> None:
     parser.add_argument("--backend", choices=("sim", "franky"))
     parser.add_argument("--host", default="127.0.0.2", help="franky-sim's address (--backend franky)")
     parser.add_argument("--out", type=Path)
-    parser.add_argument("--controller", default="trajectory", help="the franky backend's (FrankyArmConfig)")
+    parser.add_argument("--controller", help="the franky backend's (default: FrankyArmConfig's)")
     parser.add_argument("--compare", type=Path, nargs=2, metavar=("REFERENCE", "OTHER"), help="two runs side by side")
     args = parser.parse_args()
     if args.compare:

@@ -108,6 +108,36 @@ def test_the_impedance_controller_moves_and_stops_like_the_training_arm(empty_si
         again.disconnect()
 
 
+def test_an_impedance_motion_that_ended_is_noticed_at_the_next_target(empty_sim):
+    """A reflex ends the tracking motion while franky still takes references for it; the backend must
+    notice at the next target (a reflex raises its error there) and not stream into a stopped arm.
+    Here the motion is ended from outside (franky-sim raises no reflexes): the next targets start a
+    new tracking motion and the hand follows them again (tolerance: 1 cm of the 2 cm asked)."""
+    arm = connected(empty_sim, "impedance")
+    try:
+        arm.move_home()
+        T = np.array(arm.read_state().T_base_eef)
+        T[:3, :3] = TOP_DOWN_SITE
+        arm.send_target(T)
+        time.sleep(0.2)
+        arm.robot.stop()  # the motion ends as a reflex would end it
+        deadline = time.monotonic() + 2.0
+        while arm.robot.is_in_control and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert not arm.robot.is_in_control
+        start = arm.read_state().T_base_eef[:3, 3].copy()
+        for _ in range(30):
+            T = np.array(arm.read_state().T_base_eef)
+            T[:3, :3] = TOP_DOWN_SITE
+            T[:3, 3] = start + np.array([0.02, 0.0, 0.0])
+            arm.send_target(T)
+            time.sleep(0.05)
+        assert arm.robot.is_in_control
+        assert arm.read_state().T_base_eef[0, 3] - start[0] > 0.01
+    finally:
+        arm.disconnect()
+
+
 def _impedance_steps_and_home(host):
     arm = connected(host, "impedance")
     try:

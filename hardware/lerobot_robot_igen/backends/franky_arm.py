@@ -6,9 +6,9 @@ How the 20 Hz stream reaches the arm depends on ``controller``:
   simulator's controller (``training_controller``), which franky's Cartesian impedance tracker
   follows in torque mode (``franky_tracker``). The hand then moves per period as it did in the
   training simulator, and torque control raises none of the motion generator's reflexes. The
-  tracker's stiffness is 3000 N/m, the top of the range franky's predecessor documents for its
-  impedance motions; the model is kept within ``max_lead`` of the hand and the tracker's
-  position error is clipped, which bounds the push on an obstacle.
+  model is kept within ``max_lead`` of the hand and the tracker's position and orientation
+  errors are clipped, which bounds the push on an obstacle and the wrist's torque. It has run on
+  franky-sim and franka-sim, never on a real arm.
 * ``trajectory``: every period the loop sends an *absolute* Cartesian target as an asynchronous
   ``CartesianMotion``; franky's online trajectory generator (Ruckig) plans a jerk-limited path to
   it within the arm's limits scaled by ``relative_dynamics_factor`` (velocity 0.3, acceleration
@@ -58,15 +58,21 @@ class FrankyArmConfig(ArmBackendConfig):
     # impedance: the training controller's law (lerobot_env_igen.osc.OscGains: kp 150, critical damping)
     training_kp: float = 150.0  # [1/s^2]
     training_damping_ratio: float = 1.0
-    tracker_stiffness: float = 3000.0  # [N/m] a few N of model error cost about 1 mm
-    tracker_rotational_stiffness: float = 400.0  # [Nm/rad] holds the hand's orientation to about 0.2 degrees
-    # [rad] orientation error the tracker acts on at most: 8 Nm at 400 Nm/rad, under the wrist joints' 12 Nm
+    # [N/m] a few N of model error cost about 1 mm. Above the 3000 N/m franky's predecessor documents
+    # for its impedance motions: at 3000 the hand strayed past the scripted rule's 4 mm alignment
+    # window on franky-sim and it succeeded in 6 of 20 trials (20 of 20 at 5000)
+    tracker_stiffness: float = 5000.0
+    # [Nm/rad] at 400 a policy's stream took a wrist joint past its 12 Nm on franka-sim in 9 of 10 trials
+    # (tau_J_range_violation); at 150, in none. The policy observes the goal orientation (igen-deploy's
+    # --hand_orientation), so a few tenths of a degree of tilt change nothing it sees
+    tracker_rotational_stiffness: float = 150.0
+    # [rad] orientation error the tracker acts on at most: 3 Nm at 150 Nm/rad, under the wrist joints' 12 Nm
     # (franka-sim refused a 2.6 degree error at the default 0.25 rad: tau_J_range_violation)
     tracker_rotational_error_clip: float = 0.02
     tracker_mass: float = 3.0  # [kg] task-space inertia assumed for the tracker's critical damping
-    max_lead: float = 0.005  # [m] how far the model may be ahead of a hand held back: 15 N of push
-    # [m] position error the tracker acts on at most (franky's default is 0.1 m): 30 N at 3000 N/m, even
-    # when the model runs ahead within a period; free motion lags the model by 1-3 mm
+    max_lead: float = 0.005  # [m] how far the model may be ahead of a hand held back: 25 N of push
+    # [m] position error the tracker acts on at most (franky's default is 0.1 m): 50 N, even when the
+    # model runs ahead within a period; free motion lags the model by 1-3 mm
     tracker_translational_error_clip: float = 0.01
     stream_period: float = 0.002  # [s] how often the model's state is sent to the tracker
     # trajectory: franky's relative dynamics factors

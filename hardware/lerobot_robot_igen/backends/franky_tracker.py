@@ -44,17 +44,31 @@ class ImpedanceTracker:
         measured = np.asarray(state.pose.end_effector_pose.matrix, dtype=float)
         velocity = np.asarray(state.velocity.end_effector_twist.linear, dtype=float)
         now = time.perf_counter()
-        if self._model is not None and not self._thread.is_alive():
-            # the motion refused a reference (it ended: a reflex, or a stop from elsewhere): raise its error.
-            # Not polled from the robot: reading is_in_control or robot_mode every period raised torque and
-            # velocity reflexes on franka-sim, so a reflex that leaves set_reference working surfaces at
-            # the move home instead (the arm has stopped itself either way)
+        if self._model is not None and not self._call("the impedance tracker", self._running):
+            # the motion ended (a reflex, a stop from elsewhere) or refused a reference: raise its error
             self.end()
-            self._call("the impedance tracker", self._robot.join_motion, 1.0)
+            self._call("the impedance tracker", self._join_ended)
         if self._model is None:
             self._start(measured, velocity, now)
         self._rotation = np.asarray(T_base_tcp, dtype=float)[:3, :3].copy()
         self._model.set_goal(np.asarray(T_base_tcp)[:3, 3], measured[:3, 3], velocity, cfg.max_lead, now)
+
+    def _running(self) -> bool:
+        """Whether the tracking motion still runs (a cheap flag read, 0.01 ms).
+
+        A reflex ends the motion while franky still takes references for it: without this check the
+        loop would stream targets to an arm that stopped, and learn of it only at the move home.
+        """
+        return bool(self._robot.is_in_control) and self._thread is not None and self._thread.is_alive()
+
+    def _join_ended(self) -> None:
+        """Collect an ended motion's outcome: its error (a reflex) is raised; a preemption (a stop) is not one."""
+        try:
+            self._robot.join_motion(1.0)
+        except Exception as error:
+            if "preempted" not in str(error):
+                raise
+            logger.debug("the tracking motion was stopped from elsewhere; a new one starts")
 
     def _start(self, measured: np.ndarray, velocity: np.ndarray, now: float) -> None:
         franky, cfg = self._franky, self._config
