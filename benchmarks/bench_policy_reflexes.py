@@ -33,6 +33,8 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=10)
     parser.add_argument("--max_steps", type=int, default=200)
     parser.add_argument("--controller", help="the franky backend's (default: FrankyArmConfig's)")
+    parser.add_argument("--tracker_stiffness", type=float, help="[N/m] (default: FrankyArmConfig's)")
+    parser.add_argument("--tracker_rotational_stiffness", type=float, help="[Nm/rad] (default: FrankyArmConfig's)")
     args = parser.parse_args()
 
     import torch
@@ -64,8 +66,9 @@ def main() -> None:
     server = start_server("franka-sim", args.python, host)
     results = []
     try:
-        controller = {"controller": args.controller} if args.controller else {}
-        arm = FrankyArm(FrankyArmConfig(host=host, **controller))
+        names = ("controller", "tracker_stiffness", "tracker_rotational_stiffness")
+        chosen = {name: getattr(args, name) for name in names if getattr(args, name) is not None}
+        arm = FrankyArm(FrankyArmConfig(host=host, **chosen))
         arm.connect()
         goal = env_cfg.make_action_space().rotation  # as igen-deploy builds its arm
         safe = SafeArm(arm, deploy_cfg.real_world_from_base(), deploy_cfg.safety, goal_rotation=goal)

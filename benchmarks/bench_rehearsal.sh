@@ -8,11 +8,13 @@
 #
 #   bash benchmarks/bench_rehearsal.sh outputs/bg_igen/train/igen/checkpoints/last/pretrained_model 20 outputs/rehearsal
 # FRANKY_CONTROLLER=trajectory|impedance picks the franky backend's controller (default: the backend's own).
+# Further arguments go to the franky igen-deploy run, e.g. --robot.tracker_stiffness=3000.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-CHECKPOINT=${1:?usage: bench_rehearsal.sh CHECKPOINT/pretrained_model|scripted [TRIALS] [OUT_DIR]}
+CHECKPOINT=${1:?usage: bench_rehearsal.sh CHECKPOINT/pretrained_model|scripted [TRIALS] [OUT_DIR] [igen-deploy args]}
 TRIALS=${2:-20}
 OUT=${3:-outputs/rehearsal}
+EXTRA=("${@:4}")
 HOST=${FRANKY_SIM_HOST:-127.0.0.2}
 PORT=${FRANKY_SIM_SCENE_PORT:-7711}
 CONTROLLER=()
@@ -34,6 +36,6 @@ grep -q READY "$OUT/franky_sim.log" || { echo "franky-sim did not start:"; cat "
 
 .venv/bin/igen-deploy "${POLICY[@]}" --robot.type=franky --robot.host="$HOST" "${CONTROLLER[@]}" \
     --perception.type=franky_sim --perception.port="$PORT" \
-    --trials="$TRIALS" --compare_sim=true --output="$OUT/franky.json"
+    --trials="$TRIALS" --compare_sim=true --output="$OUT/franky.json" "${EXTRA[@]}"
 
 .venv/bin/python benchmarks/rehearsal_summary.py "$OUT/mujoco.json" "$OUT/franky.json"

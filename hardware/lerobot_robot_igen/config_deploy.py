@@ -113,7 +113,7 @@ class DeployConfig:
     # which its controller holds (position-only actions cannot change it); "measured": the arm's
     # reading. The training arm's reading carries its own dynamic tilt (a few tenths of a degree
     # while it moves), which a policy can learn to read and no other arm reproduces
-    # (docs/benchmarks.md: a constant 0.4 degree offset took igen-eval's 19/20 to 10-12/20).
+    # (docs/benchmarks.md: a constant 0.2 degree tilt took the Block Grasp checkpoint from 19/20 to 4/20).
     hand_orientation: str = "goal"
 
     def __post_init__(self) -> None:
