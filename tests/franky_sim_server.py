@@ -8,6 +8,7 @@ that parallel test runs do not share a robot.
 from __future__ import annotations
 
 import os
+import random
 import signal
 import subprocess
 import time
@@ -19,17 +20,44 @@ PYTHON = ROOT / "tools" / "franky_sim" / ".venv" / "bin" / "python"
 SERVE = ROOT / "tools" / "franky_sim" / "serve.py"
 
 
+BIND_ATTEMPTS = 5
+ADDRESS_TAKEN = ("Could not find available hostname", "Address already in use")  # franky-sim's, the scene port's
+
+
 def free_loopback() -> str:
-    """A loopback address unlikely to be used by another run (libfranka's ports are fixed)."""
-    return f"127.0.{os.getpid() % 200 + 20}.{int(time.time() * 1000) % 200 + 20}"
+    """A random loopback address, so that servers of parallel runs do not meet (libfranka's ports are fixed)."""
+    rng = random.SystemRandom()
+    return f"127.0.{rng.randint(20, 250)}.{rng.randint(20, 250)}"
+
+
+class AddressTakenError(RuntimeError):
+    """franky-sim could not bind its ports on the address it was given."""
 
 
 @contextmanager
 def franky_sim(cube: tuple[float, float] | None = (0.5, 0.0), timeout: float = 60.0, scene_port: int | None = None):
-    """Yield the running franky-sim server (``.host``; ``.scene_port`` when asked for); kill it afterwards."""
+    """Yield the running franky-sim server (``.host``; ``.scene_port`` when asked for); kill it afterwards.
+
+    An address whose ports are still held (by a server killed a moment ago, or another run's) is
+    replaced by a fresh one, up to BIND_ATTEMPTS times.
+    """
     if not PYTHON.exists():
         raise RuntimeError(f"franky-sim's environment is missing ({PYTHON}); run `make setup` (scripts/setup.sh)")
-    host = free_loopback()
+    for attempt in range(1, BIND_ATTEMPTS + 1):
+        try:
+            proc = _start(free_loopback(), cube, timeout, scene_port)
+            break
+        except AddressTakenError:
+            if attempt == BIND_ATTEMPTS:
+                raise
+    try:
+        yield proc
+    finally:
+        stop(proc)
+
+
+def _start(host: str, cube: tuple[float, float] | None, timeout: float, scene_port: int | None) -> subprocess.Popen:
+    """Start franky-sim on ``host`` and return it once it says READY."""
     command = [str(PYTHON), str(SERVE), "--hostname", host]
     if cube is not None:
         command += ["--cube", str(cube[0]), str(cube[1])]
@@ -51,12 +79,15 @@ def franky_sim(cube: tuple[float, float] | None = (0.5, 0.0), timeout: float = 6
         else:
             raise RuntimeError("franky-sim did not start in time:\n" + "".join(lines))
         if proc.poll() is not None:
-            raise RuntimeError("franky-sim exited:\n" + "".join(lines))
-        proc.host = host
-        proc.scene_port = scene_port
-        yield proc
-    finally:
+            output = "".join(lines)
+            error = AddressTakenError if any(m in output for m in ADDRESS_TAKEN) else RuntimeError
+            raise error("franky-sim exited:\n" + output)
+    except BaseException:
         stop(proc)
+        raise
+    proc.host = host
+    proc.scene_port = scene_port
+    return proc
 
 
 def stop(proc: subprocess.Popen) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import threading
 import time
 
+import franky_sim_server
 import numpy as np
 import pytest
 from franky_sim_server import franky_sim, free_loopback, stop
@@ -276,6 +277,17 @@ def test_nothing_listening_is_a_clear_error():
         arm.connect()
     assert time.monotonic() - start < 30.0
     assert not arm.is_connected
+
+
+def test_the_test_server_moves_to_a_fresh_address_when_its_first_is_taken(empty_sim, monkeypatch):
+    """A random loopback address can meet another server's (this run's or a parallel run's): the
+    fixture must try another instead of failing the test in setup."""
+    addresses = iter([empty_sim, free_loopback()])
+    monkeypatch.setattr(franky_sim_server, "free_loopback", lambda: next(addresses))
+    with franky_sim(cube=None) as server:
+        assert server.host != empty_sim
+        arm = connected(server.host)
+        arm.disconnect()
 
 
 def _scene_port() -> int:
