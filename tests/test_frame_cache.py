@@ -57,6 +57,16 @@ def test_cached_windows_equal_lerobots_for_every_key(source_demos, upstream_read
     assert upstream[0]["action_is_pad"][:3].all()  # the window really reached across an episode start
 
 
+def test_columns_too_large_to_hold_stay_on_lerobots_path(source_demos, upstream_reader, monkeypatch):
+    upstream = _windows(source_demos)
+    monkeypatch.setattr(frame_cache, "MAX_COLUMN_BYTES", 0)
+    cached = _windows(source_demos, cached=True)
+    for i in (0, len(upstream) // 2):
+        a, b = upstream[i], cached[i]
+        assert all(torch.equal(a[k], b[k]) for k in a if isinstance(a[k], torch.Tensor))
+    assert cached.reader._columns_for(cached.reader.hf_dataset) == {}
+
+
 def test_switched_off_by_environment(monkeypatch, upstream_reader):
     monkeypatch.setenv(frame_cache.ENV_SWITCH, "0")
     assert not frame_cache.install()
