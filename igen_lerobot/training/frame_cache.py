@@ -57,13 +57,10 @@ class CachedFrameReader(DatasetReader):
         held = getattr(self, "_frame_columns", None)
         token = (id(hf_dataset), len(hf_dataset))
         if held is None or held[0] != token:
-            held = (token, {})
+            keys = [key for key in self.delta_indices or {} if self._cacheable(key)]
+            held = (token, {key: _column_as_torch(hf_dataset, key) for key in keys})
             self._frame_columns = held
-        columns = held[1]
-        for key in self.delta_indices or {}:
-            if key not in columns and self._cacheable(key):
-                columns[key] = _column_as_torch(hf_dataset, key)
-        return columns
+        return held[1]
 
     def _cacheable(self, key: str) -> bool:
         feature = self._meta.features.get(key)
