@@ -369,3 +369,40 @@ def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(e
         np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)  # tolerance 5 mm
     finally:
         arm.disconnect()
+
+
+def test_a_move_home_that_does_not_finish_in_time_stops_the_arm_with_a_clear_error(empty_sim):
+    """The move home waits for its motion with a deadline: when the arm does not get home in time
+    (here a deadline far shorter than the move) the arm is told to stop and the caller gets an error
+    naming the setting, not a process waiting forever. The arm stays usable: with the normal
+    deadline it goes home (tolerance 5 mm)."""
+    from dataclasses import replace
+
+    from lerobot_robot_igen.driver import MotionTimeoutError
+
+    arm = connected(empty_sim)
+    try:
+        arm.move_home()
+        home = arm.read_state().T_base_eef[:3, 3].copy()
+        T = arm.read_state().T_base_eef.copy()
+        T[:3, 3] += (0.08, 0.0, -0.05)
+        arm.send_target(T)
+        time.sleep(2.0)
+        away = arm.read_state().T_base_eef[:3, 3].copy()
+        assert np.linalg.norm(away - home) > 0.05
+        arm.config = replace(arm.config, home_timeout=0.2)
+        started = time.monotonic()
+        with pytest.raises(MotionTimeoutError, match="home_timeout"):
+            arm.move_home()
+        assert time.monotonic() - started < 5.0  # the settle wait (up to 3 s) plus the 0.2 s deadline
+        time.sleep(0.5)
+        stopped = arm.read_state().T_base_eef[:3, 3].copy()
+        time.sleep(0.5)
+        assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - stopped) < 0.002  # still (tolerance 2 mm)
+        assert np.linalg.norm(stopped - home) > 0.02  # stopped on the way, not home
+        arm.config = replace(arm.config, home_timeout=FrankyArmConfig().home_timeout)
+        arm.recover()
+        arm.move_home()
+        np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)
+    finally:
+        arm.disconnect()

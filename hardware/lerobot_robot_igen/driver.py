@@ -19,7 +19,7 @@ import numpy as np
 
 from igen_lerobot.core.exceptions import IgenError
 
-__all__ = ["ArmState", "ArmDriver", "DriverError", "ConnectionLostError"]
+__all__ = ["ArmState", "ArmDriver", "DriverError", "ConnectionLostError", "MotionTimeoutError"]
 
 
 class DriverError(IgenError, RuntimeError):
@@ -28,6 +28,13 @@ class DriverError(IgenError, RuntimeError):
 
 class ConnectionLostError(DriverError):
     """The connection to the robot (or its simulator) is gone; the episode must end."""
+
+
+class MotionTimeoutError(DriverError):
+    """A blocking motion did not finish in its time; the arm was told to stop.
+
+    Not retried: an arm (or simulator) that stopped answering would only time out again.
+    """
 
 
 @dataclass(frozen=True)

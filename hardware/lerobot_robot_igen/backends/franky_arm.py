@@ -38,7 +38,7 @@ from igen_lerobot.core.exceptions import ConfigError
 from lerobot_robot_igen.backends.franky_tracker import ImpedanceTracker
 from lerobot_robot_igen.backends.gripper_worker import GripperWorker
 from lerobot_robot_igen.config_arm import ArmBackendConfig
-from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError, DriverError
+from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError, DriverError, MotionTimeoutError
 
 logger = logging.getLogger(__name__)
 
@@ -90,6 +90,9 @@ class FrankyArmConfig(ArmBackendConfig):
     open_width: float = 0.08  # [m]
     gripper_timeout: float = 5.0  # [s] the longest a gripper command may take (waited for at home and disconnect)
     settle_timeout: float = 3.0  # [s] the longest the move home waits for the last target's motion
+    # [s] the longest the move home may take before the arm is stopped and an error raised (a blocking
+    # move waits for a motion the arm may never finish: the process would hang with the arm in its hands)
+    home_timeout: float = 30.0
     tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
 
     def __post_init__(self) -> None:
@@ -103,6 +106,7 @@ class FrankyArmConfig(ArmBackendConfig):
             "tracker_mass",
             "max_lead",
             "stream_period",
+            "home_timeout",
         ):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"--robot.{name} must be > 0, got {getattr(self, name)}")
@@ -307,8 +311,8 @@ class FrankyArm(ArmDriver):
         factor = self._franky.RelativeDynamicsFactor(cfg.home_velocity_factor, cfg.acceleration_factor, cfg.jerk_factor)
         self._finish_last_motion()
         try:
-            self._call("the move home", self.robot.move, self._motion(T_home, factor))
-        except ConnectionLostError:
+            self._move_and_wait("the move home", self._motion(T_home, factor))
+        except (ConnectionLostError, MotionTimeoutError):
             raise
         except DriverError as error:
             # planned from an arm still pushing on something (a trial ending in contact) the move can
@@ -316,9 +320,9 @@ class FrankyArm(ArmDriver):
             logger.warning("%s; recovering and trying the move home once more", error)
             self._finish_last_motion()
             try:
-                self._call("the move home", self.robot.move, self._motion(T_home, factor))
+                self._move_and_wait("the move home", self._motion(T_home, factor))
             except DriverError as again:
-                if self._home_joints is None or isinstance(again, ConnectionLostError):
+                if self._home_joints is None or isinstance(again, (ConnectionLostError, MotionTimeoutError)):
                     raise
                 # a Cartesian plan can fail outright from an awkward pose (ruckig -110 seen after a
                 # policy drove the hand to the workspace corner); the joint-space path home does not
@@ -327,10 +331,28 @@ class FrankyArm(ArmDriver):
                 joints = self._franky.JointMotion(
                     self._franky.JointState(self._home_joints), relative_dynamics_factor=factor
                 )
-                self._call("the move home (joint space)", self.robot.move, joints)
+                self._move_and_wait("the move home (joint space)", joints)
         if self._home_joints is None:
             self._home_joints = self._call(
                 "a state read", lambda: np.asarray(self.robot.current_joint_positions, float)
             )
         self.set_gripper(False)
         self.wait_gripper(2 * self.config.gripper_timeout)  # a grasp still settling, then the opening
+
+    def _move_and_wait(self, what: str, motion) -> None:
+        """A blocking move with a deadline.
+
+        On timeout the arm is told to stop and the caller gets a clear error, instead of a process
+        waiting forever on franky's motion thread.
+        """
+        self._call(what, self.robot.move, motion, asynchronous=True)
+        if self._call(what, self.robot.join_motion, self.config.home_timeout):
+            return
+        try:
+            self._call("a stop", self.robot.stop)
+        except DriverError as error:
+            logger.warning("could not stop after %s timed out: %s", what, error)
+        raise MotionTimeoutError(
+            f"{what} did not finish within {self.config.home_timeout:g} s (--robot.home_timeout); the arm was "
+            "told to stop. Check that the arm (or franky-sim) still answers and nothing blocks the path home."
+        )
