@@ -61,25 +61,42 @@ def test_state_frames_and_home(empty_sim):
 
 
 def test_a_20hz_stream_of_absolute_targets_is_followed(empty_sim):
+    """A scripted target that moves 6 cm at 6 cm/s, then holds, out and back: what the trajectory
+    controller promises (module docstring of franky_arm). Measured on this machine over 70 legs: 2-3 mm
+    behind at the end of the ramp, 2-2.6 mm past the goal at most, within 0.1 mm one second later.
+    franky-sim runs slower than real time here (0.7-0.9), so the hold is a deadline, not a fixed wait.
+    Tolerances: within 5 mm for 5 periods running before 3 s of holding; under 1 cm past the goal."""
     arm = connected(empty_sim)
     safe = SafeArm(arm, world_from_base(), SafetyLimits())
     try:
         arm.move_home()
         _, T_start = safe.read()
-        # 6 cm legs: the first delta of the way back must stay inside refuse_delta (10 cm) even if the
-        # arm overshoots the far goal by a little
-        goal_out = T_start[:3, 3] + np.array([0.06, 0.0, 0.0])
         calls, ticks = [], []
-        for goal in (goal_out, T_start[:3, 3]):
-            for _ in range(40):  # 2 s per leg
-                ticks.append(time.perf_counter())
-                _, T = safe.read()
-                start = time.perf_counter()
-                safe.command(T, goal - T[:3, 3], close_gripper=False, period=0.05)
-                calls.append(time.perf_counter() - start)
-                time.sleep(max(0.0, 0.05 - (time.perf_counter() - ticks[-1])))
+
+        def stream(goal: np.ndarray) -> np.ndarray:
+            ticks.append(time.perf_counter())
             _, T = safe.read()
-            assert np.linalg.norm(T[:3, 3] - goal) < 0.005, f"did not reach {goal}: {T[:3, 3]}"  # tolerance 5 mm
+            start = time.perf_counter()
+            safe.command(T, goal - T[:3, 3], close_gripper=False, period=0.05)
+            calls.append(time.perf_counter() - start)
+            time.sleep(max(0.0, 0.05 - (time.perf_counter() - ticks[-1])))
+            return T[:3, 3]
+
+        origin = T_start[:3, 3].copy()
+        far = origin + np.array([0.06, 0.0, 0.0])
+        for start, goal in ((origin, far), (far, origin)):
+            direction = (goal - start) / np.linalg.norm(goal - start)
+            for k in range(1, 21):  # 6 cm in 1 s
+                stream(start + (goal - start) * k / 20)
+            within, past = 0, 0.0
+            for _ in range(60):  # hold, at most 3 s
+                hand = stream(goal)
+                past = max(past, float((hand - goal) @ direction))
+                within = within + 1 if np.linalg.norm(hand - goal) < 0.005 else 0
+                if within == 5:
+                    break
+            assert within == 5, f"did not settle within 5 mm of {goal} in 3 s: {hand}"
+            assert past < 0.01, f"{past * 1000:.1f} mm past {goal}"
         rate = (len(ticks) - 1) / (ticks[-1] - ticks[0])
         assert rate > 18.0, rate  # 20 Hz asked; tolerance for a busy 2-core machine
         assert np.median(calls) < 0.005  # an asynchronous move returns at once
