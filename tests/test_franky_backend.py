@@ -3,6 +3,7 @@ started on a loopback address for these tests."""
 
 from __future__ import annotations
 
+import socket
 import threading
 import time
 
@@ -294,6 +295,42 @@ def test_nothing_listening_is_a_clear_error():
         arm.connect()
     assert time.monotonic() - start < 30.0
     assert not arm.is_connected
+
+
+def test_an_address_that_never_answers_is_a_clear_error_after_the_connect_timeout():
+    """libfranka waits without end on an address that takes the connection and never answers (a
+    wrong host, a hung arm): connect() gives up after --robot.connect_timeout and names it.
+    Tolerance: 2 s deadline, raised before 5 s."""
+    host = free_loopback()
+    with socket.socket() as silent:
+        silent.bind((host, 1337))  # libfranka's command port; connections queue, nothing answers
+        silent.listen(4)
+        arm = FrankyArm(FrankyArmConfig(host=host, connect_timeout=2.0))
+        start = time.monotonic()
+        with pytest.raises(ConnectionLostError, match="connect_timeout"):
+            arm.connect()
+        assert 2.0 <= time.monotonic() - start < 5.0
+        assert not arm.is_connected
+
+
+def test_a_connection_that_answers_after_the_deadline_does_not_keep_the_arm(empty_sim):
+    """The arm takes one client at a time: while one holds it, another's connect() times out. The
+    timed-out attempt, answered once the arm is free, must be dropped, or it would hold the arm and
+    block every later connect (tolerance: the next connect succeeds within 20 s and goes home, 5 mm)."""
+    holder = connected(empty_sim)
+    try:
+        late = FrankyArm(FrankyArmConfig(host=empty_sim, connect_timeout=1.0))
+        with pytest.raises(ConnectionLostError, match="connect_timeout"):
+            late.connect()
+    finally:
+        holder.disconnect()
+    again = FrankyArm(FrankyArmConfig(host=empty_sim, connect_timeout=20.0))
+    again.connect()
+    try:
+        again.move_home()
+        np.testing.assert_allclose(again.read_state().T_base_eef[:3, 3], FrankyArmConfig().home_position, atol=0.005)
+    finally:
+        again.disconnect()
 
 
 def test_the_test_server_moves_to_a_fresh_address_when_its_first_is_taken(empty_sim, monkeypatch):

@@ -29,6 +29,7 @@ one process: both bundle libfranka.
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from dataclasses import dataclass
 
@@ -93,6 +94,9 @@ class FrankyArmConfig(ArmBackendConfig):
     # [s] the longest the move home may take before the arm is stopped and an error raised (a blocking
     # move waits for a motion the arm may never finish: the process would hang with the arm in its hands)
     home_timeout: float = 30.0
+    # [s] the longest connect() waits for the arm and gripper to answer: libfranka waits without end on an
+    # address that accepts the connection and never answers (measured against a silent socket)
+    connect_timeout: float = 10.0
     tcp_to_site_rotation: tuple[tuple[float, float, float], ...] = TCP_TO_SITE
 
     def __post_init__(self) -> None:
@@ -107,6 +111,7 @@ class FrankyArmConfig(ArmBackendConfig):
             "max_lead",
             "stream_period",
             "home_timeout",
+            "connect_timeout",
         ):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"--robot.{name} must be > 0, got {getattr(self, name)}")
@@ -163,14 +168,7 @@ class FrankyArm(ArmDriver):
 
         self._franky = franky
         cfg = self.config
-        try:
-            robot = franky.Robot(cfg.host, realtime_config=franky.RealtimeConfig.Ignore)
-            gripper = franky.Gripper(cfg.host)
-        except Exception as error:
-            raise ConnectionLostError(
-                f"cannot connect to the robot at {cfg.host} ({error}); check the address (--robot.host), the "
-                "network cable, and that FCI is enabled in Desk"
-            ) from error
+        robot, gripper = self._open_connections(franky)
         self.robot, self.gripper = robot, gripper
         self._gripper_worker = GripperWorker(
             close=lambda: gripper.grasp(
@@ -185,6 +183,44 @@ class FrankyArm(ArmDriver):
             cfg.velocity_factor, cfg.acceleration_factor, cfg.jerk_factor
         )
         self._gripper_closed = None
+
+    def _open_connections(self, franky):
+        """Open franky's Robot and Gripper in a thread, so that a silent arm costs connect_timeout, not forever.
+
+        A connection that answers after the deadline is dropped at once (freeing it closes it), so it
+        never holds the arm, which takes one client at a time.
+        """
+        cfg = self.config
+        result: dict = {}
+        gave_up = threading.Event()
+
+        def open_both() -> None:
+            try:
+                robot = franky.Robot(cfg.host, realtime_config=franky.RealtimeConfig.Ignore)
+                gripper = franky.Gripper(cfg.host)
+            except Exception as error:  # franky raises its own exception types; reported below
+                result["error"] = error
+                return
+            if not gave_up.is_set():
+                result["connections"] = (robot, gripper)
+
+        opening = threading.Thread(target=open_both, name="franky-connect", daemon=True)
+        opening.start()
+        opening.join(cfg.connect_timeout)
+        if opening.is_alive():
+            gave_up.set()
+            raise ConnectionLostError(
+                f"the robot at {cfg.host} did not answer within {cfg.connect_timeout:g} s (--robot.connect_timeout); "
+                "check the address (--robot.host), that FCI is enabled in Desk, and that no other program holds "
+                "the arm"
+            )
+        if "error" in result:
+            error = result["error"]
+            raise ConnectionLostError(
+                f"cannot connect to the robot at {cfg.host} ({error}); check the address (--robot.host), the "
+                "network cable, and that FCI is enabled in Desk"
+            ) from error
+        return result["connections"]
 
     def disconnect(self) -> None:
         if self.robot is not None:
