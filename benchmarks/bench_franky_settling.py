@@ -29,6 +29,7 @@ from bench_franky_stream import start_server
 
 PERIOD = 0.05
 DISTANCE = 0.06
+RAMP_SPEED = 0.06  # [m/s] the smooth profile's goal speed
 HOLD_PERIODS = 80
 SETTLED = 0.005
 
@@ -50,7 +51,7 @@ def idle_real_time_factor(arm, seconds: float = 2.0) -> float:
 
 def leg(safe, arm, start: np.ndarray, goal: np.ndarray, profile: str) -> dict:
     """Stream one leg; errors are sampled once per period, the goal counted as still from ``still_at``."""
-    ramp_periods = round(DISTANCE / 0.06 / PERIOD) if profile == "ramp" else 0
+    ramp_periods = round(DISTANCE / RAMP_SPEED / PERIOD) if profile == "ramp" else 0
     direction = (goal - start) / np.linalg.norm(goal - start)
     errors, past = [], 0.0
     robot0, wall0 = robot_seconds(arm), time.perf_counter()
