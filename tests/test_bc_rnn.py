@@ -126,3 +126,24 @@ def test_fast_rollout_sampler_draws_from_the_same_mixture():
         low = head.sample(features, low_noise=True)
     distance = (means - low[:, None, :]).norm(dim=-1).min(dim=-1).values
     assert (distance < 1e-3).all()
+
+
+def test_cosine_schedule_anneals_the_rate_to_zero_over_the_training_steps():
+    from igen_lerobot.core.exceptions import ConfigError
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+
+    assert BCRNNConfig().get_scheduler_preset() is None  # robomimic's constant rate stays the default
+    preset = BCRNNConfig(lr_schedule="cosine").get_scheduler_preset()
+    weight = torch.nn.Parameter(torch.zeros(1))
+    optimizer = torch.optim.Adam([weight], lr=1e-3)
+    scheduler = preset.build(optimizer, num_training_steps=100)
+    rates = []
+    for _ in range(100):
+        rates.append(optimizer.param_groups[0]["lr"])
+        optimizer.step()
+        scheduler.step()
+    assert rates[0] == pytest.approx(1e-3) and rates[50] == pytest.approx(5e-4, rel=0.05)
+    assert optimizer.param_groups[0]["lr"] == pytest.approx(0.0, abs=1e-12)
+    assert all(a >= b for a, b in zip(rates, rates[1:], strict=False))
+    with pytest.raises(ConfigError, match="policy.lr_schedule must be one of"):
+        BCRNNConfig(lr_schedule="linear")

@@ -8,13 +8,17 @@ import json
 import os
 import subprocess
 import sys
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from igen_lerobot.core.paper import VARIANTS
 from igen_lerobot.datasets.reader import load_episodes
-from igen_lerobot.experiments.table import LABELS
+from igen_lerobot.experiments.config_table import TableConfig
+from igen_lerobot.experiments.provenance import code_version, provenance_problems
+from igen_lerobot.experiments.table_steps import LABELS
 
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
 
@@ -32,6 +36,8 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
         "--train.batch_size=8",
         "--train.num_workers=0",
         "--n_trials=2",
+        "--n_val_trials=2",
+        "--train_seeds=[7,8]",
         "--workers=1",
         "--in_process=true",
         f"--output_dir={out}",
@@ -45,8 +51,37 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     markdown = results.read_text()
     for row in report["rows"]:
         low, high = row["ci95"]
-        assert 0 <= low <= row["success_rate"] <= high <= 1 and row["trials"] == 2
+        # two training seeds, each tested on 2 trials: the interval is on the 4 pooled trials
+        assert [s["seed"] for s in row["seeds"]] == [7, 8] and row["trials"] == 4
+        assert 0 <= low <= row["success_rate"] <= high <= 1
+        rates = [s["test"]["success_rate"] for s in row["seeds"]]
+        assert row["success_rate"] == sum(rates) / 2 and row["min"] == min(rates) and row["max"] == max(rates)
+        for seed in row["seeds"]:
+            # the checkpoint is the best on validation; the test trials are others, run on that checkpoint
+            assert seed["validation_rate"] == max(seed["validation"].values())
+            test = json.loads(
+                (
+                    out / "eval" / row["variant"] / f"seed{seed['seed']}" / f"test_step{seed['chosen_step']}.json"
+                ).read_text()
+            )
+            validation = json.loads(
+                (out / "eval" / row["variant"] / f"seed{seed['seed']}" / "validation.json").read_text()
+            )
+            assert test["seed"] != validation["seed"] and test["n_trials"] == 2
+            assert test["results"][0]["policy"].endswith(f"{seed['chosen_step']:06d}/pretrained_model")
         assert f"| {LABELS[row['variant']]} |" in markdown
+    # each seed trained its own run, the first one also the policy the interventions came from
+    assert (out / "train" / "base" / "seed7").is_dir() and (out / "train" / "igen" / "seed8").is_dir()
+    igen_cmd = next(c["command"] for c in report["commands"] if c["step"] == "igen")
+    assert "train/base/seed7/" in igen_cmd
+    # the JSON names the code that made every step and the whole config
+    assert report["code"] == code_version()
+    problems = provenance_problems(report)
+    if report["code"]["dirty"]:  # a developer's working tree: only the dirtiness may be missing
+        assert problems and all("uncommitted changes" in p for p in problems)
+    else:  # CI's clean clone
+        assert problems == []
+    assert set(report["step_code"]) == {c["step"] for c in report["commands"]}
     tools = {c["command"].split()[0] for c in report["commands"]}
     assert tools == {"igen-collect", "igen-generate", "igen-merge", "lerobot-train", "igen-eval"}
     assert "lerobot-train --policy.type=bc_rnn" in markdown
@@ -77,13 +112,71 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
 
 def test_shipped_results_are_what_igen_table_renders_from_their_json():
     """docs/results.md is the page igen-table renders from docs/results/*.json: no hand-edited numbers."""
-    from igen_lerobot.experiments.table import load_results, render_markdown, render_page
+    from igen_lerobot.experiments.table_report import load_results, load_superseded, render_page
 
     docs = Path(__file__).resolve().parents[1] / "docs"
-    tables = load_results(docs / "results")
-    by_name = {result["name"]: result for result, _ in tables}
-    assert [row["variant"] for row in by_name["block_grasp"]["rows"]] == list(VARIANTS)
-    assert (docs / "results.md").read_text() == render_page(tables)
-    result = by_name["block_grasp"]
-    every_second = {**result, "config": {**result["config"], "eval_every": 2}}
-    assert "one in every 2 saved checkpoints, 50 trials" in "\n".join(render_markdown(every_second))
+    tables, superseded = load_results(docs / "results"), load_superseded(docs / "results")
+    assert superseded, "the superseded tables stay on the page for the record"
+    assert (docs / "results.md").read_text() == render_page(tables, superseded)
+
+
+def test_every_shipped_table_names_its_commit_and_config():
+    """A published table must say which code and settings made each step (so a fresh run can check it)."""
+    from igen_lerobot.experiments.table_report import load_results
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    for result, _ in load_results(docs / "results"):
+        assert provenance_problems(result) == [], result["name"]
+
+
+def test_provenance_check_names_what_is_missing():
+    good = {
+        "code": {"commit": "a" * 40, "dirty": False},
+        "commands": [{"step": "base", "command": "igen-generate"}, {"step": "train_base_seed0", "command": "x"}],
+        "step_code": {"base": {"commit": "a" * 40, "dirty": False}, "train_base_seed0": {"commit": "b" * 40}},
+        "config": json.loads(json.dumps(asdict(TableConfig()))),
+    }
+    assert provenance_problems(good) == []
+    no_step = {**good, "step_code": {"base": good["step_code"]["base"]}}
+    assert provenance_problems(no_step) == ["step train_base_seed0: no commit recorded"]
+    dirty = {**good, "step_code": {**good["step_code"], "base": {"commit": "c" * 40, "dirty": True}}}
+    assert provenance_problems(dirty) == ["step base: made with uncommitted changes at cccccccccc"]
+    partial = {**good, "config": {"task": "block_grasp"}, "code": {}}
+    problems = provenance_problems(partial)
+    assert problems[0].startswith("no commit") and "train_seeds" in problems[1]
+
+
+def test_superseded_tables_render_with_their_curves():
+    from igen_lerobot.experiments.table_report import load_superseded, render_page
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    page = render_page([], load_superseded(docs / "results"))
+    assert "## Superseded tables" in page and "### Nut Insertion (full observability on contact), superseded" in page
+    # Nut Insertion I-Gen's checkpoints as recorded: 0 / 0 / 78 / 82 / 76
+    assert "| I-Gen | 82% (98) | 69–90% | 4000 | 0 / 0 / 78 / 82 / 76 |" in page
+
+
+def test_a_resumed_table_refuses_settings_that_change_finished_steps(tmp_path):
+    from igen_lerobot.core.exceptions import ConfigError
+    from igen_lerobot.experiments.table import check_resumed_config
+
+    out = str(tmp_path / "t")
+    check_resumed_config(TableConfig(output_dir=out, variants=["base"]))
+    # more rows, more seeds, other worker counts: the finished steps stay valid
+    check_resumed_config(TableConfig(output_dir=out, variants=["base", "igen"], train_seeds=[1000, 1001, 1002, 7]))
+    check_resumed_config(TableConfig(output_dir=out, workers=1))
+    with pytest.raises(ConfigError, match=r"n_trials: 50 -> 20.*new --output_dir"):
+        check_resumed_config(TableConfig(output_dir=out, n_trials=20))
+    with pytest.raises(ConfigError, match="first seed trains the policy"):
+        check_resumed_config(TableConfig(output_dir=out, train_seeds=[5, 1000]))
+
+
+def test_table_config_refuses_seeds_that_break_the_protocol():
+    from igen_lerobot.core.exceptions import ConfigError
+
+    assert TableConfig().train_seeds == [1000, 1001, 1002]
+    assert TableConfig(train_seeds=[5, 6]).train.seed == 5  # the base policy's seed is the first
+    with pytest.raises(ConfigError, match="distinct seeds"):
+        TableConfig(train_seeds=[1, 1])
+    with pytest.raises(ConfigError, match="--val_seed and --test_seed must differ"):
+        TableConfig(val_seed=3, test_seed=3)

@@ -3,14 +3,15 @@
 Every step is the public command a user would run (``igen-collect``, ``igen-generate``,
 ``igen-merge``, ``lerobot-train``, ``igen-eval``), executed as a subprocess and recorded, so the
 report lists exactly the commands that made its numbers. A step whose output is complete is
-skipped, so re-running an interrupted table resumes it.
+skipped, so re-running an interrupted table resumes it; each step records the commit it ran at.
 
-Datasets (``output_dir/data``): ``source_demos`` (true poses) -> ``base`` = D, MimicGen demos;
-the base policy trained on D; ``source_int`` = human-gated interventions on that policy;
-``test_demos`` = demonstrations in the test environment (corrupted observation, the operator
-sees the truth) -> ``mg_test_demos``; ``igen_no_policy`` and ``igen`` generated from
-``source_int``. Each variant trains on D plus its part (Weighted Src Int: interventions repeated
-until they are sampled as often as D).
+Datasets (``output_dir/data``, :mod:`~igen_lerobot.experiments.table_steps`): ``source_demos``
+(true poses) -> ``base`` = D, MimicGen demos; the base policy trained on D (first training seed);
+``source_int`` = human-gated interventions on that policy; ``test_demos`` = demonstrations in the
+test environment (corrupted observation, the operator sees the truth) -> ``mg_test_demos``;
+``igen_no_policy`` and ``igen`` generated from ``source_int``. Each variant trains on D plus its
+part, once per training seed (``train/<variant>/seed<k>``); every run's checkpoint is chosen on
+validation trials and its success measured on test trials no choice has seen.
 """
 
 from __future__ import annotations
@@ -23,35 +24,30 @@ import shlex
 import subprocess
 import sys
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from importlib.metadata import entry_points
 from pathlib import Path
 
-from igen_lerobot.core.exceptions import IgenError
+from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.evaluation.checkpoints import best_result
+from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
-from igen_lerobot.training.lerobot_train import final_checkpoint, run_command, train_command
+from igen_lerobot.experiments.provenance import code_version
+from igen_lerobot.experiments.table_report import load_results, load_superseded, render_page, results_folder
+from igen_lerobot.experiments.table_steps import (
+    BASE_STEPS,
+    LABELS,
+    VARIANT_PART,
+    VARIANT_WEIGHTS,
+    DataStep,
+    needed_parts,
+)
+from igen_lerobot.training.lerobot_train import final_checkpoint, run_command, step_checkpoint, train_command
 
 logger = logging.getLogger(__name__)
 
-LABELS = {
-    "base": "Base",
-    "source_int": "Source Int",
-    "weighted_src_int": "Weighted Src Int",
-    "source_demo": "Source Demo",
-    "mg_demo": "MG Demo",
-    "igen_no_policy": "I-Gen − Policy",
-    "igen": "I-Gen",
-}
-# what each variant adds to the base dataset D (None: D alone), and with which weights
-VARIANT_PART = {
-    "base": None,
-    "source_int": "source_int",
-    "weighted_src_int": "source_int",
-    "source_demo": "test_demos",
-    "mg_demo": "mg_test_demos",
-    "igen_no_policy": "igen_no_policy",
-    "igen": "igen",
-}
+# config fields a resumed table may change: they do not change what a finished step made
+RESUMABLE_CHANGES = ("variants", "train_seeds", "workers", "in_process", "results", "output_dir")
 
 
 class StepFailedError(IgenError, RuntimeError):
@@ -66,10 +62,13 @@ class TableRun:
         self.out = Path(cfg.output_dir)
         self.bin = Path(sys.executable).parent
         self.commands: list[dict] = []
-        # step -> seconds, kept on disk so that a table resumed over several sessions still
-        # knows how long every step took
+        self.code = code_version()
+        # step -> seconds and step -> code version, kept on disk so that a table resumed over
+        # several sessions still knows how long every step took and which code made it
         self.timings_file = self.out / "step_times.json"
-        self.timings: dict[str, float] = json.loads(self.timings_file.read_text()) if self.timings_file.exists() else {}
+        self.timings: dict[str, float] = _read_json(self.timings_file, {})
+        self.versions_file = self.out / "step_commits.json"
+        self.versions: dict[str, dict] = _read_json(self.versions_file, {})
 
     def data(self, name: str) -> Path:
         return self.out / "data" / name
@@ -98,14 +97,20 @@ class TableRun:
         if code == 0 and done.exists():
             # a resumed step adds this leg to what earlier legs recorded
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
-            self.timings_file.parent.mkdir(parents=True, exist_ok=True)
+            self.versions[name] = self.code
+            self.out.mkdir(parents=True, exist_ok=True)
             self.timings_file.write_text(json.dumps(self.timings, indent=2))
+            self.versions_file.write_text(json.dumps(self.versions, indent=2))
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
 
     def igen(self, tool: str, *args: str) -> list[str]:
         return [str(self.bin / tool), *args]
+
+
+def _read_json(path: Path, default):
+    return json.loads(path.read_text()) if path.exists() else default
 
 
 def _run_in_process(command: list[str], log: Path) -> int:
@@ -139,102 +144,47 @@ def env_args(cfg: TableConfig) -> list[str]:
     return [f"--env.type={cfg.task}", *([f"--env.reveal={cfg.reveal}"] if cfg.reveal is not None else [])]
 
 
+def check_resumed_config(cfg: TableConfig) -> None:
+    """Refuse to resume a table under settings that change what its finished steps made.
+
+    The first run writes ``table_config.json``; a later run may add variants or seeds, but a
+    changed size, seed or training setting would mix two protocols in one table.
+    """
+    recorded_file = Path(cfg.output_dir) / "table_config.json"
+    now = json.loads(json.dumps(asdict(cfg)))
+    if not recorded_file.exists():
+        recorded_file.parent.mkdir(parents=True, exist_ok=True)
+        recorded_file.write_text(json.dumps(now, indent=2))
+        return
+    recorded = json.loads(recorded_file.read_text())
+    changed = sorted(k for k in now if k not in RESUMABLE_CHANGES and recorded.get(k) != now[k])
+    if recorded.get("train_seeds") and now["train_seeds"][0] != recorded["train_seeds"][0]:
+        changed.append("train_seeds (the first seed trains the policy the data were made with)")
+    if changed:
+        detail = "; ".join(f"{k}: {recorded.get(k.split()[0])} -> {now.get(k.split()[0])}" for k in changed)
+        raise ConfigError(
+            f"{cfg.output_dir} holds a table made with other settings ({detail}); give the same flags to "
+            "resume it, or a new --output_dir for a new table"
+        )
+
+
+def build_step(run: TableRun, step: DataStep, policy: str) -> None:
+    """Make one dataset of the table of steps (skipped when it is complete)."""
+    run.run(
+        step.name,
+        run.igen(step.tool, *step.command(run.cfg, run.data, env_args(run.cfg), policy)),
+        _complete(run.data(step.name)),
+    )
+
+
 def build_datasets(run: TableRun) -> dict[str, Path]:
     """Collect, generate and merge everything the chosen variants need; returns their training datasets."""
     cfg = run.cfg
-    env = env_args(cfg)
-    needs = {VARIANT_PART[v] for v in cfg.variants} - {None}
-    n_src, workers = str(cfg.source_episodes), f"--workers={cfg.workers}"
-
-    run.run(
-        "source_demos",
-        run.igen(
-            "igen-collect",
-            *env,
-            "--mode=demos",
-            f"--num_episodes={n_src}",
-            f"--seed={cfg.seed}",
-            f"--dataset.root={run.data('source_demos')}",
-        ),
-        _complete(run.data("source_demos")),
-    )
-    run.run(
-        "base",
-        run.igen(
-            "igen-generate",
-            "--mode=mimicgen",
-            *env,
-            f"--source.root={run.data('source_demos')}",
-            f"--num_episodes={cfg.base_demos}",
-            f"--seed={cfg.seed}",
-            workers,
-            f"--dataset.root={run.data('base')}",
-        ),
-        _complete(run.data("base")),
-    )
-    base_ckpt = train(run, "base", run.data("base"))
-    policy = f"--policy.path={base_ckpt}"
-    if needs & {"source_int", "igen", "igen_no_policy"}:
-        run.run(
-            "source_int",
-            run.igen(
-                "igen-collect",
-                *env,
-                "--mode=interventions",
-                f"--num_episodes={n_src}",
-                f"--seed={cfg.seed + 1}",
-                policy,
-                f"--dataset.root={run.data('source_int')}",
-            ),
-            _complete(run.data("source_int")),
-        )
-    if needs & {"test_demos", "mg_test_demos"}:
-        run.run(
-            "test_demos",
-            run.igen(
-                "igen-collect",
-                *env,
-                "--mode=demos",
-                "--demo_observation=corrupted",
-                f"--num_episodes={n_src}",
-                f"--seed={cfg.seed + 2}",
-                f"--dataset.root={run.data('test_demos')}",
-            ),
-            _complete(run.data("test_demos")),
-        )
-    if "mg_test_demos" in needs:
-        run.run(
-            "mg_test_demos",
-            run.igen(
-                "igen-generate",
-                "--mode=mimicgen",
-                "--demo_observation=corrupted",
-                *env,
-                f"--source.root={run.data('test_demos')}",
-                f"--num_episodes={cfg.generated}",
-                f"--seed={cfg.seed + 3}",
-                workers,
-                f"--dataset.root={run.data('mg_test_demos')}",
-            ),
-            _complete(run.data("mg_test_demos")),
-        )
-    for mode, extra in (("igen_no_policy", []), ("igen", [policy])):
-        if mode in needs:
-            run.run(
-                mode,
-                run.igen(
-                    "igen-generate",
-                    f"--mode={mode}",
-                    *env,
-                    f"--source.root={run.data('source_int')}",
-                    f"--num_episodes={cfg.generated}",
-                    f"--seed={cfg.seed + 4}",
-                    workers,
-                    *extra,
-                    f"--dataset.root={run.data(mode)}",
-                ),
-                _complete(run.data(mode)),
-            )
+    for step in BASE_STEPS:
+        build_step(run, step, policy="")
+    base_policy = str(train(run, "base", run.data("base"), cfg.train_seeds[0]))
+    for step in needed_parts(cfg.variants):
+        build_step(run, step, base_policy)
 
     datasets = {"base": run.data("base")}
     for variant in cfg.variants:
@@ -242,7 +192,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
         if part is None:
             continue
         merged = run.data(f"train_{variant}")
-        weights = ["--weights=[1,1]"] if variant == "weighted_src_int" else []
+        weights = [f"--weights={VARIANT_WEIGHTS[variant]}"] if variant in VARIANT_WEIGHTS else []
         run.run(
             f"merge_{variant}",
             run.igen(
@@ -258,35 +208,96 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
     return datasets
 
 
-def train(run: TableRun, variant: str, dataset: Path) -> Path:
-    """``lerobot-train`` on a variant's dataset (same config for all); returns the last checkpoint."""
-    out = run.out / "train" / variant
-    done = final_checkpoint(out, run.cfg.train.steps) / "config.json"
-    command = train_command(run.cfg.train, dataset, f"local/{dataset.name}", out)
-    execute = None if done.exists() else run_command(run.cfg.train, dataset, f"local/{dataset.name}", out)
-    run.run(f"train_{variant}", command, done, execute)
+def train_dir(run: TableRun, variant: str, seed: int) -> Path:
+    """One training run's ``--output_dir``: ``train/<variant>/seed<k>``."""
+    return run.out / "train" / variant / f"seed{seed}"
+
+
+def train(run: TableRun, variant: str, dataset: Path, seed: int) -> Path:
+    """``lerobot-train`` on a variant's dataset with one seed (same config for all); returns the last checkpoint."""
+    cfg = replace(run.cfg.train, seed=seed, extra_args=list(run.cfg.train.extra_args))
+    out = train_dir(run, variant, seed)
+    done = final_checkpoint(out, cfg.steps) / "config.json"
+    command = train_command(cfg, dataset, f"local/{dataset.name}", out)
+    execute = None if done.exists() else run_command(cfg, dataset, f"local/{dataset.name}", out)
+    run.run(f"train_{variant}_seed{seed}", command, done, execute)
     return done.parent
 
 
-def evaluate_variant(run: TableRun, variant: str) -> dict:
-    """``igen-eval`` over the variant's checkpoints; returns its JSON report."""
+def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: int, seed: int) -> dict:
     cfg = run.cfg
-    report = run.out / "eval" / f"{variant}.json"
     run.run(
-        f"eval_{variant}",
+        name,
         run.igen(
             "igen-eval",
             *env_args(cfg),
-            f"--train_dir={run.out / 'train' / variant}",
-            f"--every={cfg.eval_every}",
-            f"--n_trials={cfg.n_trials}",
-            f"--seed={cfg.eval_seed}",
+            *target,
+            f"--n_trials={n_trials}",
+            f"--seed={seed}",
             f"--policy.device={cfg.train.device}",
             f"--output={report}",
         ),
         report,
     )
     return json.loads(report.read_text())
+
+
+def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
+    """Choose the run's checkpoint on validation trials, then measure it on the test trials."""
+    cfg = run.cfg
+    folder = run.out / "eval" / variant / f"seed{seed}"
+    trained = train_dir(run, variant, seed)
+    validation = _eval(
+        run,
+        f"validate_{variant}_seed{seed}",
+        folder / "validation.json",
+        [f"--train_dir={trained}", f"--every={cfg.eval_every}"],
+        cfg.n_val_trials,
+        cfg.val_seed,
+    )
+    chosen = best_result([EvalResult(**r) for r in validation["results"]])
+    checkpoint = step_checkpoint(trained, cfg.train.steps, chosen.step)
+    test = _eval(
+        run,
+        f"test_{variant}_seed{seed}",
+        folder / f"test_step{chosen.step}.json",
+        [f"--policy.path={checkpoint}"],
+        cfg.n_trials,
+        cfg.test_seed,
+    )["best"]
+    return {
+        "seed": seed,
+        "chosen_step": chosen.step,
+        "validation_rate": chosen.success_rate,
+        "validation": {r["step"]: r["success_rate"] for r in validation["results"]},
+        "test": {k: test[k] for k in ("successes", "trials", "success_rate", "ci95")},
+    }
+
+
+def summarise_row(variant: str, seeds: list[dict], paper: int | None, dataset: dict) -> dict:
+    """A row: the mean test rate over training seeds, its spread, and a Wilson interval on the pooled trials.
+
+    The interval covers trial-to-trial chance only; the spread (min, max, standard deviation) is
+    the training seeds' share, shown beside it rather than folded in.
+    """
+    rates = [s["test"]["success_rate"] for s in seeds]
+    mean = sum(rates) / len(rates)
+    std = (sum((r - mean) ** 2 for r in rates) / (len(rates) - 1)) ** 0.5 if len(rates) > 1 else 0.0
+    successes, trials = sum(s["test"]["successes"] for s in seeds), sum(s["test"]["trials"] for s in seeds)
+    return {
+        "variant": variant,
+        "label": LABELS[variant],
+        "success_rate": mean,
+        "std": std,
+        "min": min(rates),
+        "max": max(rates),
+        "ci95": list(wilson_interval(successes, trials)),
+        "trials": trials,
+        "validation_rate": sum(s["validation_rate"] for s in seeds) / len(seeds),
+        "seeds": seeds,
+        "paper": paper,
+        "dataset": dataset,
+    }
 
 
 def _dataset_size(root: Path) -> dict:
@@ -296,6 +307,7 @@ def _dataset_size(root: Path) -> dict:
 
 def run_table(cfg: TableConfig) -> dict:
     """Build, train and evaluate every variant; write the table's JSON and re-render the results page."""
+    check_resumed_config(cfg)
     run = TableRun(cfg)
     start = time.perf_counter()
     env = cfg.env_config()
@@ -303,138 +315,38 @@ def run_table(cfg: TableConfig) -> dict:
     datasets = build_datasets(run)
     rows = []
     for variant in cfg.variants:
-        if variant != "base":
-            train(run, variant, datasets[variant])
-        report = evaluate_variant(run, variant)
-        best = report["best"]
-        rows.append(
-            {
-                "variant": variant,
-                "label": LABELS[variant],
-                "success_rate": best["success_rate"],
-                "ci95": best["ci95"],
-                "best_step": best["step"],
-                "trials": best["trials"],
-                "per_checkpoint": {r["step"]: r["success_rate"] for r in report["results"]},
-                "paper": None if paper is None else paper.success.get(variant),
-                "dataset": _dataset_size(datasets[variant]),
-            }
-        )
+        seeds = []
+        for seed in cfg.train_seeds:
+            train(run, variant, datasets[variant], seed)
+            seeds.append(evaluate_seed(run, variant, seed))
+        paper_rate = None if paper is None else paper.success.get(variant)
+        rows.append(summarise_row(variant, seeds, paper_rate, _dataset_size(datasets[variant])))
+    ran = {step["step"] for step in run.commands}
     result = {
         "task": cfg.task,
         "name": cfg.name,
         "reveal": env.reveal.value,
         "config": asdict(cfg),
+        "code": run.code,
+        "step_code": {step: run.versions.get(step) for step in sorted(ran)},
         "rows": rows,
         "commands": run.commands,
         "wall_time_s": time.perf_counter() - start,
-        "step_times_s": run.timings,
+        "step_times_s": {step: t for step, t in run.timings.items() if step in ran},
     }
     results = Path(cfg.results)
     folder = results_folder(results)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
-    results.write_text(render_page(load_results(folder)))
+    results.write_text(render_page(load_results(folder), load_superseded(folder)))
     return result
-
-
-def results_folder(results_md: Path) -> Path:
-    """Where the tables behind a results page live: ``docs/results.md`` -> ``docs/results/``."""
-    return Path(results_md).with_suffix("")
-
-
-def load_results(folder: Path) -> list[tuple[dict, str]]:
-    """Every table JSON in ``folder`` with its hand-written reading (``<name>.notes.md``, may be empty)."""
-    tables = []
-    for path in sorted(Path(folder).glob("*.json")):
-        notes = path.with_name(path.stem + ".notes.md")
-        tables.append((json.loads(path.read_text()), notes.read_text() if notes.exists() else ""))
-    return tables
-
-
-def _which_checkpoints(k: int) -> str:
-    return "every saved checkpoint" if k == 1 else f"one in every {k} saved checkpoints"
-
-
-def _title(result: dict) -> str:
-    task = result["task"].replace("_", " ").title()
-    reveal = result.get("reveal", "full")
-    observability = {
-        "full": "full observability on contact",
-        "none": "nothing revealed",
-        "contact_position": "partial observability: first contact position",
-        "direction": "partial observability: direction to the true pose",
-    }.get(reveal, reveal)
-    return f"{task} ({observability})"
-
-
-def render_page(tables: list[tuple[dict, str]]) -> str:
-    """The results page: one section per table (``docs/results.md``)."""
-    lines = [
-        "# Results",
-        "",
-        "Success rate of the best evaluated checkpoint over seeded trials under the task's observation",
-        "error, with a 95% Wilson interval; within a table every variant is trained with the same",
-        "`lerobot-train` settings on the base dataset D plus its own part. Produced by `igen-table`; the",
-        "JSON of each table (`docs/results/<table>.json`) holds the same numbers, per-checkpoint rates and",
-        "the config, and this page is rendered from those files.",
-        "",
-    ]
-    for result, notes in tables:
-        lines += render_markdown(result, notes)
-    return "\n".join(lines)
-
-
-def render_markdown(result: dict, notes: str = "") -> list[str]:
-    """One table's section: the table, a reading of it, the protocol and the commands."""
-    cfg = result["config"]
-    lines = [
-        f"## {_title(result)}",
-        "",
-        "| Variant | ours | 95% CI | best step | paper (sim) | training data |",
-        "|---|---|---|---|---|---|",
-    ]
-    for row in result["rows"]:
-        low, high = row["ci95"]
-        paper = "–" if row["paper"] is None else f"{row['paper']}%"
-        data = f"{row['dataset']['episodes']} episodes, {row['dataset']['frames']} frames"
-        lines.append(
-            f"| {row['label']} | {100 * row['success_rate']:.0f}% ({row['trials']} trials) | "
-            f"{100 * low:.0f}–{100 * high:.0f}% | {row['best_step']} | {paper} | {data} |"
-        )
-    if notes.strip():
-        lines += ["", notes.strip()]
-    train = cfg["train"]
-    lines += [
-        "",
-        "Protocol:",
-        "",
-        f"- {cfg['source_episodes']} source episodes of each kind (scripted operator), "
-        f"{cfg['base_demos']} MimicGen demonstrations in D, "
-        f"{cfg['generated']} generated episodes per generated variant.",
-        f"- `lerobot-train --policy.type={train['policy_type']}`: "
-        f"{train['steps']} steps × batch {train['batch_size']}, "
-        f"checkpoint every {train['save_freq'] or train['steps']} steps, "
-        f"device {train['device']}, seed {train['seed']}.",
-        f"- `igen-eval`: {_which_checkpoints(cfg['eval_every'])}, {cfg['n_trials']} trials from seed "
-        f"{cfg['eval_seed']}; the best is reported.",
-        f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
-        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
-        "",
-        "Commands:",
-        "",
-        "```bash",
-        *[c["command"] for c in result["commands"]],
-        "```",
-        "",
-    ]
-    return lines
 
 
 def table_command(cfg: TableConfig) -> dict:
     """``igen-table``: run the table and print it."""
     result = run_table(cfg)
     for row in result["rows"]:
-        print(f"{row['label']:>18}: {100 * row['success_rate']:5.1f}%  (paper: {row['paper']})")
+        per_seed = ", ".join(f"{100 * s['test']['success_rate']:.0f}" for s in row["seeds"])
+        print(f"{row['label']:>18}: {100 * row['success_rate']:5.1f}%  (seeds: {per_seed}; paper: {row['paper']})")
     print(f"Wrote {cfg.results} and {results_folder(Path(cfg.results)) / (cfg.name + '.json')}")
     return result

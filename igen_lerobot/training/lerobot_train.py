@@ -24,11 +24,16 @@ def checkpoint_path(output_dir: Path) -> Path:
     return Path(output_dir) / "checkpoints" / "last" / "pretrained_model"
 
 
-def final_checkpoint(output_dir: Path, steps: int) -> Path:
-    """The ``pretrained_model/`` folder a run of ``steps`` steps leaves at its end (named as LeRobot names it)."""
+def step_checkpoint(output_dir: Path, steps: int, step: int) -> Path:
+    """The ``pretrained_model/`` folder a run of ``steps`` steps saves at ``step`` (named as LeRobot names it)."""
     from lerobot.common.train_utils import get_step_checkpoint_dir
 
-    return get_step_checkpoint_dir(Path(output_dir), steps, steps) / "pretrained_model"
+    return get_step_checkpoint_dir(Path(output_dir), steps, step) / "pretrained_model"
+
+
+def final_checkpoint(output_dir: Path, steps: int) -> Path:
+    """The ``pretrained_model/`` folder a run of ``steps`` steps leaves at its end."""
+    return step_checkpoint(output_dir, steps, steps)
 
 
 def last_saved_step(output_dir: Path) -> int | None:

@@ -13,8 +13,11 @@ from dataclasses import dataclass, field
 
 from lerobot.configs import FeatureType, NormalizationMode, PreTrainedConfig
 from lerobot.optim.optimizers import AdamConfig
+from lerobot.optim.schedulers import CosineAnnealingWithWarmupSchedulerConfig
 
 from igen_lerobot.core.exceptions import ConfigError
+
+LR_SCHEDULES = ("constant", "cosine")
 
 
 @PreTrainedConfig.register_subclass("bc_rnn")
@@ -41,6 +44,9 @@ class BCRNNConfig(PreTrainedConfig):
     optimizer_lr: float = 1e-3
     optimizer_weight_decay: float = 0.0
     optimizer_grad_clip_norm: float = 1e6  # robomimic does not clip gradients
+    # "constant" (robomimic's default) or "cosine": anneal the rate to zero over lerobot-train's --steps,
+    # so the last checkpoints stop swinging with the last batches (docs/results.md, reproducibility)
+    lr_schedule: str = "constant"
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -50,6 +56,8 @@ class BCRNNConfig(PreTrainedConfig):
             raise ConfigError(f"policy.horizon must be >= 1, got {self.horizon}")
         if self.gmm_num_modes < 1:
             raise ConfigError(f"policy.gmm_num_modes must be >= 1, got {self.gmm_num_modes}")
+        if self.lr_schedule not in LR_SCHEDULES:
+            raise ConfigError(f"policy.lr_schedule must be one of {list(LR_SCHEDULES)}, got {self.lr_schedule!r}")
         if self.n_obs_steps != 1:
             raise ConfigError("policy.n_obs_steps must be 1 for bc_rnn (the RNN carries the history)")
 
@@ -58,7 +66,9 @@ class BCRNNConfig(PreTrainedConfig):
             lr=self.optimizer_lr, weight_decay=self.optimizer_weight_decay, grad_clip_norm=self.optimizer_grad_clip_norm
         )
 
-    def get_scheduler_preset(self) -> None:
+    def get_scheduler_preset(self) -> CosineAnnealingWithWarmupSchedulerConfig | None:
+        if self.lr_schedule == "cosine":
+            return CosineAnnealingWithWarmupSchedulerConfig(num_warmup_steps=0)
         return None
 
     def validate_features(self) -> None:

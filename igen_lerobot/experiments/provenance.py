@@ -1,0 +1,69 @@
+"""Which code made a result: the git commit of the checkout igen-lerobot runs from.
+
+A table runs for hours and resumes across sessions; its JSON names the commit of every step so
+a reader can tell a table made by one code version from one assembled while the code changed.
+"""
+
+from __future__ import annotations
+
+import subprocess
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+
+
+def _git(*args: str) -> str | None:
+    try:
+        done = subprocess.run(
+            ["git", "-C", str(REPO_ROOT), *args], capture_output=True, text=True, timeout=30, check=False
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return done.stdout.strip() if done.returncode == 0 else None
+
+
+def code_version() -> dict:
+    """``{"commit", "dirty", "version"}``: commit None when not run from a git checkout (an installed wheel).
+
+    ``dirty`` says tracked files differ from the commit, so the commit alone does not name the code.
+    """
+    try:
+        package = version("igen-lerobot")
+    except PackageNotFoundError:
+        package = None
+    commit = _git("rev-parse", "HEAD") if (REPO_ROOT / ".git").exists() else None
+    dirty = None
+    if commit is not None:
+        status = _git("status", "--porcelain", "--untracked-files=no")
+        dirty = None if status is None else bool(status)
+    return {"commit": commit, "dirty": dirty, "version": package}
+
+
+def provenance_problems(result: dict) -> list[str]:
+    """What a table's JSON lacks to name the code and config that made it (empty: nothing).
+
+    Every recorded command's step must name a commit of a clean checkout, and the config must be
+    the table's full config, so that the commands and the commit regenerate the numbers.
+    """
+    from igen_lerobot.experiments.config_table import TableConfig
+
+    problems = []
+    code = result.get("code") or {}
+    if not code.get("commit"):
+        problems.append("no commit for the run that assembled the table (code.commit)")
+    steps = {c["step"] for c in result.get("commands", [])}
+    if not steps:
+        problems.append("no commands recorded")
+    for step in sorted(steps):
+        made_by = (result.get("step_code") or {}).get(step)
+        if not made_by or not made_by.get("commit"):
+            problems.append(f"step {step}: no commit recorded")
+        elif made_by.get("dirty"):
+            problems.append(f"step {step}: made with uncommitted changes at {made_by['commit'][:10]}")
+    config = result.get("config")
+    fields = set(TableConfig.__dataclass_fields__)
+    if not isinstance(config, dict) or set(config) != fields:
+        missing = sorted(fields - set(config or {}))
+        problems.append(f"config is not a whole TableConfig (missing {missing})")
+    return problems

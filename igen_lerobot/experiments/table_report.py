@@ -1,0 +1,176 @@
+"""The results page (``docs/results.md``) rendered from the tables' JSON files, never edited by hand."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+SUPERSEDED = "superseded"  # subfolder of tables kept for the record: one seed, checkpoint chosen on the reported trials
+
+
+def results_folder(results_md: Path) -> Path:
+    """Where the tables behind a results page live: ``docs/results.md`` -> ``docs/results/``."""
+    return Path(results_md).with_suffix("")
+
+
+def _with_notes(path: Path) -> tuple[dict, str]:
+    notes = path.with_name(path.stem + ".notes.md")
+    return json.loads(path.read_text()), notes.read_text() if notes.exists() else ""
+
+
+def load_results(folder: Path) -> list[tuple[dict, str]]:
+    """Every table JSON in ``folder`` with its hand-written reading (``<name>.notes.md``, may be empty)."""
+    return [_with_notes(path) for path in sorted(Path(folder).glob("*.json"))]
+
+
+def load_superseded(folder: Path) -> list[tuple[dict, str]]:
+    """The superseded tables (``<folder>/superseded/``), with their notes."""
+    return load_results(Path(folder) / SUPERSEDED)
+
+
+def _which_checkpoints(k: int) -> str:
+    return "every saved checkpoint" if k == 1 else f"one in every {k} saved checkpoints"
+
+
+def _title(result: dict) -> str:
+    task = result["task"].replace("_", " ").title()
+    reveal = result.get("reveal", "full")
+    observability = {
+        "full": "full observability on contact",
+        "none": "nothing revealed",
+        "contact_position": "partial observability: first contact position",
+        "direction": "partial observability: direction to the true pose",
+    }.get(reveal, reveal)
+    return f"{task} ({observability})"
+
+
+def _pct(rate: float) -> str:
+    return f"{100 * rate:.0f}"
+
+
+def _code_line(result: dict) -> str:
+    """Which commits made the table's steps: one, or each with the steps it made."""
+    by_commit: dict[str, list[str]] = {}
+    for step, code in result.get("step_code", {}).items():
+        key = (
+            "unrecorded"
+            if not code or not code.get("commit")
+            else code["commit"][:10] + (" + uncommitted changes" if code.get("dirty") else "")
+        )
+        by_commit.setdefault(key, []).append(step)
+    if len(by_commit) == 1:
+        return f"- Code: every step ran at commit {next(iter(by_commit))}."
+    parts = "; ".join(f"{commit}: {len(steps)} steps" for commit, steps in sorted(by_commit.items()))
+    return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
+
+
+def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str]] = ()) -> str:
+    """The results page: one section per table, then the superseded tables (``docs/results.md``)."""
+    lines = [
+        "# Results",
+        "",
+        "Success rate on held-out test trials under the task's observation error, as the mean over",
+        "training seeds. Each seed's checkpoint is chosen on separate validation trials; the test trials",
+        "never take part in a choice. Within a table every variant is trained with the same",
+        "`lerobot-train` settings on the base dataset D plus its own part. Produced by `igen-table`; the",
+        "JSON of each table (`docs/results/<table>.json`) holds the same numbers, every seed's",
+        "validation curve, the config and the commit of every step, and this page is rendered from",
+        "those files.",
+        "",
+    ]
+    for result, notes in tables:
+        lines += render_markdown(result, notes)
+    if superseded:
+        lines += [
+            "## Superseded tables",
+            "",
+            "Made before the protocol above: one training seed per row, the best of its checkpoints on the",
+            "same trials it reports, assembled across sessions while the code changed. A fresh run does not",
+            "reproduce them (see the reproducibility study); they stay here for the record.",
+            "",
+        ]
+        for result, notes in superseded:
+            lines += render_superseded(result, notes)
+    return "\n".join(lines)
+
+
+def render_markdown(result: dict, notes: str = "") -> list[str]:
+    """One table's section: the table, a reading of it, the protocol and the commands."""
+    cfg = result["config"]
+    lines = [
+        f"## {_title(result)}",
+        "",
+        "| Variant | ours (paper) | 95% CI | test rate per seed | spread (sd) | validation, best checkpoint "
+        "| chosen steps | training data |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for row in result["rows"]:
+        low, high = row["ci95"]
+        paper = "–" if row["paper"] is None else f"{row['paper']}"
+        per_seed = " / ".join(_pct(s["test"]["success_rate"]) for s in row["seeds"])
+        steps = " / ".join(str(s["chosen_step"]) for s in row["seeds"])
+        data = f"{row['dataset']['episodes']} episodes, {row['dataset']['frames']} frames"
+        lines.append(
+            f"| {row['label']} | {_pct(row['success_rate'])}% ({paper}) | {_pct(low)}–{_pct(high)}% | {per_seed} | "
+            f"{_pct(row['min'])}–{_pct(row['max'])} ({_pct(row['std'])}) | {_pct(row['validation_rate'])}% | "
+            f"{steps} | {data} |"
+        )
+    if notes.strip():
+        lines += ["", notes.strip()]
+    train = cfg["train"]
+    extra = f" `{' '.join(train['extra_args'])}`," if train["extra_args"] else ""
+    lines += [
+        "",
+        "Protocol:",
+        "",
+        f"- {cfg['source_episodes']} source episodes of each kind (scripted operator), "
+        f"{cfg['base_demos']} MimicGen demonstrations in D, "
+        f"{cfg['generated']} generated episodes per generated variant.",
+        f"- `lerobot-train --policy.type={train['policy_type']}`:{extra} "
+        f"{train['steps']} steps × batch {train['batch_size']}, "
+        f"checkpoint every {train['save_freq'] or train['steps']} steps, device {train['device']}, "
+        f"training seeds {', '.join(map(str, cfg['train_seeds']))} (the first one's base policy collects "
+        "and generates the interventions).",
+        f"- Checkpoint choice: {_which_checkpoints(cfg['eval_every'])} on {cfg['n_val_trials']} validation "
+        f"trials from seed {cfg['val_seed']}; the rate reported is that checkpoint's on {cfg['n_trials']} "
+        f"test trials from seed {cfg['test_seed']}. 95% CI: Wilson, on all seeds' test trials together.",
+        _code_line(result),
+        f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
+        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
+        "",
+        "Commands:",
+        "",
+        "```bash",
+        *[c["command"] for c in result["commands"]],
+        "```",
+        "",
+    ]
+    return lines
+
+
+def render_superseded(result: dict, notes: str = "") -> list[str]:
+    """A table in the old protocol: one seed, best checkpoint on the reported trials."""
+    cfg = result["config"]
+    lines = [
+        f"### {_title(result)}, superseded",
+        "",
+        "| Variant | ours (paper), best checkpoint | 95% CI | best step | per checkpoint |",
+        "|---|---|---|---|---|",
+    ]
+    for row in result["rows"]:
+        low, high = row["ci95"]
+        paper = "–" if row["paper"] is None else f"{row['paper']}"
+        curve = " / ".join(_pct(rate) for rate in row["per_checkpoint"].values())
+        lines.append(
+            f"| {row['label']} | {_pct(row['success_rate'])}% ({paper}) | {_pct(low)}–{_pct(high)}% | "
+            f"{row['best_step']} | {curve} |"
+        )
+    train = cfg["train"]
+    lines += [
+        "",
+        f"{train['steps']} training steps × batch {train['batch_size']}, seed {train['seed']}; "
+        f"{cfg['n_trials']} trials from seed {cfg['eval_seed']}.",
+    ]
+    if notes.strip():
+        lines += ["", notes.strip()]
+    return [*lines, ""]

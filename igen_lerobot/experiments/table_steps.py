@@ -1,0 +1,102 @@
+"""The datasets a table builds, as a table of steps: each is one ``igen-collect`` or ``igen-generate`` command.
+
+A task's table that needs another dataset (more generated interventions for a data-scaling row, a
+second geometry's demonstrations) adds a :class:`DataStep` and a :data:`VARIANT_PART` entry; the
+runner builds, in order, only the steps the chosen variants need.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from igen_lerobot.experiments.config_table import TableConfig
+
+LABELS = {
+    "base": "Base",
+    "source_int": "Source Int",
+    "weighted_src_int": "Weighted Src Int",
+    "source_demo": "Source Demo",
+    "mg_demo": "MG Demo",
+    "igen_no_policy": "I-Gen − Policy",
+    "igen": "I-Gen",
+}
+# what each variant adds to the base dataset D (None: D alone), and with which merge weights
+VARIANT_PART = {
+    "base": None,
+    "source_int": "source_int",
+    "weighted_src_int": "source_int",
+    "source_demo": "test_demos",
+    "mg_demo": "mg_test_demos",
+    "igen_no_policy": "igen_no_policy",
+    "igen": "igen",
+}
+VARIANT_WEIGHTS = {"weighted_src_int": "[1,1]"}  # interventions repeated until sampled as often as D
+
+
+def _sources(cfg: TableConfig) -> int:
+    return cfg.source_episodes
+
+
+def _generated(cfg: TableConfig) -> int:
+    return cfg.generated
+
+
+@dataclass(frozen=True)
+class DataStep:
+    """One dataset under ``data/``: the tool, its mode flags, what it reads and how many episodes it makes."""
+
+    name: str
+    tool: str  # igen-collect or igen-generate
+    mode_args: tuple[str, ...]
+    episodes: Callable[[TableConfig], int]
+    seed_offset: int  # the step's seed is the table's --seed plus this
+    source: str | None = None  # the dataset it generates from (--source.root)
+    policy: bool = False  # runs the base policy (--policy.path): built after the base training
+
+    def command(self, cfg: TableConfig, data: Callable[[str], object], env: list[str], policy: str) -> list[str]:
+        """The step's arguments (after the tool), as a user would type them."""
+        return [
+            *self.mode_args,
+            *env,
+            *([f"--source.root={data(self.source)}"] if self.source else []),
+            f"--num_episodes={self.episodes(cfg)}",
+            f"--seed={cfg.seed + self.seed_offset}",
+            *([f"--workers={cfg.workers}"] if self.tool == "igen-generate" else []),
+            *([f"--policy.path={policy}"] if self.policy else []),
+            f"--dataset.root={data(self.name)}",
+        ]
+
+
+# D first (the base policy trains on it), then what the variants add
+BASE_STEPS = (
+    DataStep("source_demos", "igen-collect", ("--mode=demos",), _sources, 0),
+    DataStep("base", "igen-generate", ("--mode=mimicgen",), lambda cfg: cfg.base_demos, 0, source="source_demos"),
+)
+PART_STEPS = (
+    DataStep("source_int", "igen-collect", ("--mode=interventions",), _sources, 1, policy=True),
+    DataStep("test_demos", "igen-collect", ("--mode=demos", "--demo_observation=corrupted"), _sources, 2),
+    DataStep(
+        "mg_test_demos",
+        "igen-generate",
+        ("--mode=mimicgen", "--demo_observation=corrupted"),
+        _generated,
+        3,
+        source="test_demos",
+    ),
+    DataStep("igen_no_policy", "igen-generate", ("--mode=igen_no_policy",), _generated, 4, source="source_int"),
+    DataStep("igen", "igen-generate", ("--mode=igen",), _generated, 4, source="source_int", policy=True),
+)
+
+
+def needed_parts(variants: list[str], steps: tuple[DataStep, ...] = PART_STEPS) -> list[DataStep]:
+    """The part steps the variants need, their sources included, in table order."""
+    by_name = {step.name: step for step in steps}
+    wanted = {VARIANT_PART[v] for v in variants} - {None}
+    pending = list(wanted)
+    while pending:
+        source = by_name[pending.pop()].source
+        if source in by_name and source not in wanted:
+            wanted.add(source)
+            pending.append(source)
+    return [step for step in steps if step.name in wanted]
