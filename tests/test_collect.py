@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 
 from igen_lerobot.collection.record import record_demo, record_intervention
+from igen_lerobot.core.agents import Operator
 from igen_lerobot.core.episode import EpisodeKind
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.seeding import episode_seed
@@ -46,3 +47,37 @@ def test_episode_seeds_are_reproducible_and_distinct():
     assert seeds == [episode_seed(0, a) for a in range(1000)]
     assert len(set(seeds)) == 1000
     assert episode_seed(1, 0) != episode_seed(0, 0)
+
+
+def test_intervention_recording_repeats_with_a_sampling_policy(bc_rnn_checkpoint, block_grasp_config):
+    """The same seed records the same intervention whatever used torch's generator before: the policy's
+    mixture-mode draws are seeded from the episode's seed (unseeded, igen-collect's source interventions,
+    and so every I-Gen dataset made from them, changed from run to run)."""
+    import torch
+
+    from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+    class Watching(Operator):  # takes over late, so the policy's draws decide most of the episode
+        def wants_control(self, env, in_control):
+            self.steps += 1
+            return self.steps > 30
+
+        def reset(self, env):
+            self.steps = 0
+
+        def act(self, env):
+            return np.zeros(len(env.spec.action_names))
+
+    policy = make_base_policy(PolicySourceConfig(path=str(bc_rnn_checkpoint)), block_grasp_config)
+    env = block_grasp_config.make_task_env()
+    operator = Watching()
+    try:
+        first = record_intervention(env, policy, operator, seed=5, max_steps=40)
+        torch.rand(1000)  # whatever else drew from the generator in between
+        record_intervention(env, policy, operator, seed=6, max_steps=40)
+        again = record_intervention(env, policy, operator, seed=5, max_steps=40)
+        assert (first.source == FrameSource.POLICY).sum() == 30 and len(first.action) == 40
+        np.testing.assert_array_equal(first.action, again.action)
+        np.testing.assert_array_equal(first.state, again.state)
+    finally:
+        env.close()

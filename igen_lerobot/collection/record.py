@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import logging
 
-from igen_lerobot.core.agents import Operator, Policy
+from igen_lerobot.core.agents import Operator, Policy, seed_policy
 from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.pacing import RatePacer
 from igen_lerobot.core.recorder import EpisodeRecorder
@@ -44,6 +44,7 @@ def record_intervention(
     """Human-gated: the operator watches the policy and takes over when it judges a mistake."""
     obs = env.reset(seed)
     policy.reset()
+    seed_policy(policy, seed)  # the policy's own sampling too: the same command records the same episodes
     operator.reset(env)
     recorder = EpisodeRecorder(env)
     in_control, success, takeovers = False, False, 0
