@@ -33,7 +33,7 @@ from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
 from igen_lerobot.experiments.provenance import code_version
-from igen_lerobot.experiments.table_report import load_results, load_superseded, render_page, results_folder
+from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import (
     BASE_STEPS,
     LABELS,
@@ -338,7 +338,7 @@ def run_table(cfg: TableConfig) -> dict:
     folder = results_folder(results)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
-    results.write_text(render_page(load_results(folder), load_superseded(folder)))
+    results.write_text(render_results_page(folder))
     return result
 
 

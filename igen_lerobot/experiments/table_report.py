@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 SUPERSEDED = "superseded"  # subfolder of tables kept for the record: one seed, checkpoint chosen on the reported trials
+STUDY = "reproducibility.md"  # why earlier tables did not reproduce, measured: rendered after the page's introduction
 
 
 def results_folder(results_md: Path) -> Path:
@@ -26,6 +27,17 @@ def load_results(folder: Path) -> list[tuple[dict, str]]:
 def load_superseded(folder: Path) -> list[tuple[dict, str]]:
     """The superseded tables (``<folder>/superseded/``), with their notes."""
     return load_results(Path(folder) / SUPERSEDED)
+
+
+def load_study(folder: Path) -> str:
+    """The reproducibility study's text (``<folder>/reproducibility.md``), empty when there is none."""
+    path = Path(folder) / STUDY
+    return path.read_text() if path.exists() else ""
+
+
+def render_results_page(folder: Path) -> str:
+    """The whole page from a results folder: its tables, the study, the superseded tables."""
+    return render_page(load_results(folder), load_superseded(folder), load_study(folder))
 
 
 def _which_checkpoints(k: int) -> str:
@@ -64,8 +76,8 @@ def _code_line(result: dict) -> str:
     return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
 
 
-def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str]] = ()) -> str:
-    """The results page: one section per table, then the superseded tables (``docs/results.md``)."""
+def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str]] = (), study: str = "") -> str:
+    """The results page: one section per table, the study, then the superseded tables (``docs/results.md``)."""
     lines = [
         "# Results",
         "",
@@ -80,6 +92,8 @@ def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str
     ]
     for result, notes in tables:
         lines += render_markdown(result, notes)
+    if study.strip():
+        lines += [study.strip(), ""]
     if superseded:
         lines += [
             "## Superseded tables",
