@@ -29,10 +29,10 @@ from lerobot_env_igen.nut_insertion.spec import (
     PEG_CENTER_Z,
     PEG_HALF,
     SPEC,
-    TABLE_TOP_Z,
     paper_corruption,
 )
 from lerobot_env_igen.panda import TOP_DOWN_ROT
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 from lerobot_env_igen.panda_task import GRIPPER, PandaTaskEnv
 from lerobot_env_igen.scene import box
 

@@ -19,8 +19,9 @@ import numpy as np
 from igen_lerobot.core.agents import TakeoverOperator
 from igen_lerobot.core.geometry import make_pose, pos_quat_to_pose
 from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE, TaskEnv
-from lerobot_env_igen.nut_insertion.spec import NUT_HALF_THICKNESS, PEG_HALF, TABLE_TOP_Z
+from lerobot_env_igen.nut_insertion.spec import NUT_HALF_THICKNESS, PEG_HALF
 from lerobot_env_igen.panda import TOP_DOWN_ROT
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 
 HOLDING_WIDTH = 0.036  # [m] the fingers are on the handle (3.2 cm wide) below this width
 
