@@ -9,16 +9,17 @@ from lerobot.envs.configs import EnvConfig
 from igen_lerobot.core.actions import ActionSpace, DeltaPoseActions
 from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.error_models import ErrorModel
 from igen_lerobot.core.paper import VARIANTS, PaperTable
 from igen_lerobot.core.task import TaskEnv
+from lerobot_env_igen.config_panda_task import PandaTaskEnvConfig
 from lerobot_env_igen.nut_insertion.spec import SPEC, paper_corruption
+from lerobot_env_igen.placement import UniformRegion
 
 
 @EnvConfig.register_subclass("nut_insertion")
 @dataclass
-class NutInsertionEnvConfig(TaskEnvConfig):
+class NutInsertionEnvConfig(PandaTaskEnvConfig):
     """Nut Insertion with the paper's peg position error (+-4 cm per axis, at least 2 cm in one).
 
     Examples: ``lerobot-eval --env.type=nut_insertion --policy.path=.../pretrained_model``;
@@ -50,12 +51,12 @@ class NutInsertionEnvConfig(TaskEnvConfig):
     )
 
     task: str | None = "NutInsertion-v0"
-    fps: int = SPEC.fps
-    episode_length: int = SPEC.max_episode_steps
     corruption: ErrorModel = field(default_factory=paper_corruption)
     peg_region: tuple[float, float] = (0.10, 0.10)  # [m] x, y extents of the peg's region
-    max_delta: float = 0.03  # [m] per-step clip on the commanded end-effector displacement
     max_rotation: float = 0.2  # [rad] per-step clip on the commanded end-effector rotation
+
+    def region(self) -> UniformRegion:
+        return UniformRegion(self.peg_region, flag="env.peg_region")
 
     def make_action_space(self) -> ActionSpace:
         return DeltaPoseActions(max_delta=self.max_delta, max_rotation=self.max_rotation)
@@ -63,13 +64,7 @@ class NutInsertionEnvConfig(TaskEnvConfig):
     def make_task_env(self) -> TaskEnv:
         from lerobot_env_igen.nut_insertion.env import NutInsertionEnv
 
-        return NutInsertionEnv(
-            corruption=self.corruption,
-            reveal=self.reveal,
-            peg_region=self.peg_region,
-            max_delta=self.max_delta,
-            max_rotation=self.max_rotation,
-        )
+        return NutInsertionEnv(self)
 
     def make_scripted_operator(self) -> Operator:
         from lerobot_env_igen.nut_insertion.scripted import ScriptedInsertionOperator

@@ -15,12 +15,10 @@ mean position of that first contact). 6-DOF delta-pose actions at 20 Hz.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from igen_lerobot.core.actions import DeltaPoseActions
-from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.error_models import ErrorModel
-from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.geometry import rot_z
 from lerobot_env_igen.nut_insertion.spec import (
     NUT_HANDLE_GRIP_X,
@@ -28,13 +26,15 @@ from lerobot_env_igen.nut_insertion.spec import (
     ON_PEG_Z,
     PEG_CENTER_Z,
     PEG_HALF,
-    SPEC,
-    paper_corruption,
 )
 from lerobot_env_igen.panda import TOP_DOWN_ROT
 from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 from lerobot_env_igen.panda_task import GRIPPER, PandaTaskEnv
+from lerobot_env_igen.placement import RegionPlacer
 from lerobot_env_igen.scene import box
+
+if TYPE_CHECKING:
+    from lerobot_env_igen.nut_insertion.config import NutInsertionEnvConfig
 
 HOME_EEF_POS = (-0.062, 0.0, 1.0)  # [m] with the nut held, its centre is over the region's centre, 6 cm above the peg
 NUT_YAW = np.pi  # the handle points back towards the robot
@@ -54,30 +54,16 @@ def square_nut():
 class NutInsertionEnv(PandaTaskEnv):
     """The Nut Insertion task on the compiled robosuite Panda scene."""
 
-    def __init__(
-        self,
-        corruption: ErrorModel | None = None,
-        reveal: Reveal = Reveal.FULL,
-        peg_region: tuple[float, float] = (0.10, 0.10),
-        peg_center: tuple[float, float] = (0.0, 0.0),
-        max_delta: float = 0.03,
-        max_rotation: float = 0.2,
-    ) -> None:
-        if min(peg_region) < 0:
-            raise ConfigError(f"env.peg_region must be non-negative (x, y) extents [m], got {peg_region}")
+    def __init__(self, config: NutInsertionEnvConfig) -> None:
         super().__init__(
-            spec=SPEC.with_reveal(reveal),
-            action_space=DeltaPoseActions(max_delta=max_delta, max_rotation=max_rotation),
-            error_model=corruption if corruption is not None else paper_corruption(),
+            config,
             objects=[square_nut(), box("peg", PEG_HALF, PEG_RGBA, fixed=True)],
             home_pos=HOME_EEF_POS,
         )
-        self.peg_region = np.asarray(peg_region, dtype=float)
-        self.peg_center = np.asarray(peg_center, dtype=float)
+        self.peg_placer = RegionPlacer("peg", config.region(), z=PEG_CENTER_Z)
 
     def place(self, rng: np.random.Generator) -> None:
-        xy = self.peg_center + rng.uniform(-0.5, 0.5, size=2) * self.peg_region
-        self.set_fixed_pose("peg", (xy[0], xy[1], PEG_CENTER_Z))
+        self.peg_placer.place(self, rng)
         # the nut in the hand: fingers across the handle, the pads' centres at the handle's mid-height
         grip = self.arm.eef_pos()
         rot = rot_z(NUT_YAW)
