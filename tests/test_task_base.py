@@ -148,8 +148,12 @@ def test_the_scripted_operator_takes_over_when_its_takeover_rule_says_so():
     assert patient.wants_control(env, in_control=True)  # once in control it keeps it
 
 
-def test_block_grasp_builds_its_takeover_from_the_shared_rule():
+def test_the_shipped_tasks_build_their_takeover_from_their_geometry():
+    pytest.importorskip("mujoco")
     from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator
+    from lerobot_env_igen.nut_insertion.config import NutInsertionEnvConfig
 
+    nut = NutInsertionEnvConfig().make_scripted_operator()
+    assert nut.takeover == HELD_ON_PEG and nut.patience_steps == 150
     grasp = ScriptedGraspOperator()
     assert grasp.takeover == GRASP and grasp.patience_steps == 100

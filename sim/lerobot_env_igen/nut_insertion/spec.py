@@ -1,8 +1,9 @@
 """Nut Insertion's static description: importable without MuJoCo or robosuite."""
 
 from igen_lerobot.core.error_models import BoxNoise
-from igen_lerobot.core.task import ObjectBox, SubtaskSpec
-from lerobot_env_igen.panda_spec import POSE_ACTION_NAMES, TABLE_TOP_Z, panda_spec
+from igen_lerobot.core.task import ObjectBox
+from lerobot_env_igen.in_hand_insertion_spec import InsertionGeometry, in_hand_insertion_spec
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 
 # robosuite's square nut (models/assets/objects/square-nut.xml): a square ring 8.75 cm outside with
 # a 4.55 cm hole, 2 cm thick, and a handle box centred 5.4 cm out along the nut's x axis.
@@ -14,14 +15,21 @@ PEG_TOP_Z = TABLE_TOP_Z + 2 * PEG_HALF[2]
 ON_PEG_XY = 0.03  # [m] robosuite's on_peg: nut centre within 3 cm of the peg axis in x and y ...
 ON_PEG_Z = 0.05  # [m] ... and below the table top + 5 cm
 
-SPEC = panda_spec(
+GEOMETRY = InsertionGeometry(
+    held="nut",
+    target="peg",
+    held_bottom=NUT_HALF_THICKNESS,
+    target_top=PEG_HALF[2],
+    target_origin_z=PEG_CENTER_Z,
+    seat_z=TABLE_TOP_Z,  # the nut goes down the peg to the table
+    holding_width=0.036,  # the fingers are on the handle (3.2 cm wide) below this width
+    slides_in_xy=0.006,  # 6.75 mm clearance per side: a nut closer than this to the axis slides on
+)
+
+SPEC = in_hand_insertion_spec(
     name="nut_insertion",
     instruction="Place the square nut held in the hand onto the square peg.",
-    objects=("nut", "peg"),
-    subtasks=(SubtaskSpec(name="insert", object_name="peg"),),
-    action_names=POSE_ACTION_NAMES,
-    corrupted_object="peg",
-    reveal_contact=("nut", "peg"),
+    geometry=GEOMETRY,
     boxes=(
         ObjectBox("nut", half_size=(0.0615, 0.04375, NUT_HALF_THICKNESS), center=(0.0178, 0.0, 0.0)),
         ObjectBox("peg", half_size=PEG_HALF),
