@@ -20,8 +20,8 @@ import numpy as np
 
 from lerobot_env_igen.block_grasp.spec import CUBE_HALF
 from lerobot_env_igen.d415 import D415Noise, d415_frame
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 from lerobot_env_igen.rgbd import Prop, RGBDCamera
-from lerobot_env_igen.scene import TABLE_TOP_Z
 
 SPLITS = {"dev": 0xDE7, "test": 0x7E57}
 GRIPPER_GREY = (0.55, 0.55, 0.57, 1.0)

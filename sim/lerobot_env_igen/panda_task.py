@@ -1,34 +1,39 @@
 """What every simulated task shares: a Panda at a table, objects, the belief, the action space.
 
-A task supplies its scene objects, how a seed places them (:meth:`PandaTaskEnv.place`), its
-success test and, if it differs from the default, its mistake signal and subtask progress. The
-base does the rest the same way for every task: one compiled model whose free objects are set
-through their joints and fixed ones (peg, receptacle, holder) through ``model.body_pos`` at
-reset, 6-DOF or position-only actions at 20 Hz, contact detection between any two named parts,
-the core's :class:`~igen_lerobot.core.belief.ObjectBelief` for the corrupted object, and the
-observation layout of :mod:`igen_lerobot.core.task`.
+A task's env is built from its config (:class:`~lerobot_env_igen.config_panda_task.PandaTaskEnvConfig`:
+spec, action space, error model); it supplies its scene objects, how a seed places them
+(:meth:`PandaTaskEnv.place`, usually a :class:`~lerobot_env_igen.placement.RegionPlacer` handed the
+reset's generator), its success test and, if it differs from the default, its mistake signal and
+subtask progress. The base does the rest the same way for every task: one compiled model whose
+free objects are set through their joints and fixed ones (peg, receptacle, holder) through
+``model.body_pos`` at reset, 6-DOF or position-only actions at 20 Hz, contact detection between
+any two named parts, the core's :class:`~igen_lerobot.core.belief.ObjectBelief` for the corrupted
+object, and the observation layout of :mod:`igen_lerobot.core.task`.
 """
 
 from __future__ import annotations
 
 import abc
 import logging
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
-from igen_lerobot.core.actions import ActionSpace
 from igen_lerobot.core.belief import ObjectBelief, Reveal
-from igen_lerobot.core.error_models import ErrorModel
 from igen_lerobot.core.observation import observation
-from igen_lerobot.core.task import StepInfo, TaskEnv, TaskSpec
+from igen_lerobot.core.task import StepInfo, TaskEnv
 from lerobot_env_igen.cameras import PANDA_CAMERAS
 from lerobot_env_igen.panda import TOP_DOWN_ROT, ContactEvent, PandaArm
+from lerobot_env_igen.panda_spec import GRIPPER
 from lerobot_env_igen.scene import build_panda_table_scene
+
+if TYPE_CHECKING:
+    from lerobot_env_igen.config_panda_task import PandaTaskEnvConfig
 
 logger = logging.getLogger(__name__)
 
-GRIPPER = "gripper"  # the hand and fingers, as a contact party
+__all__ = ["PandaTaskEnv", "GRIPPER"]
 
 
 class PandaTaskEnv(TaskEnv):
@@ -36,18 +41,19 @@ class PandaTaskEnv(TaskEnv):
 
     def __init__(
         self,
-        spec: TaskSpec,
-        action_space: ActionSpace,
-        error_model: ErrorModel,
+        config: PandaTaskEnvConfig,
         objects: list,
         home_pos: tuple[float, float, float],
         home_rot: np.ndarray = TOP_DOWN_ROT,
     ) -> None:
+        """``objects``: the scene's robosuite objects; ``home_pos`` [m]: where the grip site starts."""
+        spec, action_space = config.task_spec, config.make_action_space()
         if tuple(action_space.names) != tuple(spec.action_names):
             raise ValueError(f"task {spec.name!r}: action space {action_space.names} != spec {spec.action_names}")
         self.spec = spec
         self.action_space = action_space
-        self.error_model = error_model
+        self.error_model = config.corruption
+        self.max_delta = float(config.max_delta)
         model, default_qpos = build_panda_table_scene(objects)
         home = np.asarray(home_pos, dtype=float)
         self.arm = PandaArm(model, default_qpos, home, control_hz=spec.fps, home_rot=home_rot)
@@ -63,7 +69,7 @@ class PandaTaskEnv(TaskEnv):
         self._reveal_watch = None
         if spec.reveal_contact is not None:
             self._reveal_watch = tuple(self.part_masks[p] for p in spec.reveal_contact)
-        self.belief = ObjectBelief(error_model, error_model.sample(np.random.default_rng(0)), spec.reveal)
+        self.belief = ObjectBelief(self.error_model, self.error_model.sample(np.random.default_rng(0)), spec.reveal)
         self.last_reveal_contact: ContactEvent | None = None  # the contact that revealed, for tests and logs
         self._steps = 0
         self._renderer: mujoco.Renderer | None = None
@@ -102,6 +108,13 @@ class PandaTaskEnv(TaskEnv):
         body = self.bodies[name]
         self.model.body_pos[body] = pos
         self.model.body_quat[body] = quat_wxyz
+
+    def set_pose(self, name: str, pos: np.ndarray, quat_wxyz: np.ndarray = (1.0, 0.0, 0.0, 0.0)) -> None:
+        """Place an object, free or fixed (what a :class:`~lerobot_env_igen.placement.RegionPlacer` calls)."""
+        if name in self._free_qpos:
+            self.set_free_pose(name, pos, quat_wxyz)
+        else:
+            self.set_fixed_pose(name, pos, quat_wxyz)
 
     def part_of_geom(self, geom: int) -> str | None:
         """Which named part (an object or ``gripper``) a geom belongs to."""

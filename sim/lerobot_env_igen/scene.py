@@ -13,10 +13,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
+
 logger = logging.getLogger(__name__)
 
-TABLE_FULL_SIZE = (0.8, 0.8, 0.05)  # [m]
-TABLE_TOP_Z = 0.8  # [m] world height of the table surface
+TABLE_FULL_SIZE = (0.8, 0.8, 0.05)  # [m] (the top at TABLE_TOP_Z)
 CUBE_RGBA = (1.0, 0.0, 0.0, 1.0)
 
 

@@ -9,16 +9,17 @@ from lerobot.envs.configs import EnvConfig
 from igen_lerobot.core.actions import ActionSpace, DeltaPositionActions
 from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.error_models import ErrorModel
 from igen_lerobot.core.paper import VARIANTS, PaperTable
 from igen_lerobot.core.task import TaskEnv
 from lerobot_env_igen.block_grasp.spec import SPEC, paper_corruption
+from lerobot_env_igen.config_panda_task import PandaTaskEnvConfig
+from lerobot_env_igen.placement import UniformRegion
 
 
 @EnvConfig.register_subclass("block_grasp")
 @dataclass
-class BlockGraspEnvConfig(TaskEnvConfig):
+class BlockGraspEnvConfig(PandaTaskEnvConfig):
     """Block Grasp with the paper's pose error (+-1 cm x, +-7 cm y, |y| >= 2.5 cm).
 
     Example: ``lerobot-eval --env.type=block_grasp --policy.path=outputs/train/.../pretrained_model``
@@ -35,11 +36,11 @@ class BlockGraspEnvConfig(TaskEnvConfig):
     )
 
     task: str | None = "BlockGrasp-v0"
-    fps: int = SPEC.fps
-    episode_length: int = SPEC.max_episode_steps
     corruption: ErrorModel = field(default_factory=paper_corruption)
     cube_region: tuple[float, float] = (0.20, 0.30)  # [m] x, y extents of the cube's start region
-    max_delta: float = 0.03  # [m] per-step clip on the commanded end-effector displacement
+
+    def region(self) -> UniformRegion:
+        return UniformRegion(self.cube_region, flag="env.cube_region")
 
     def make_action_space(self) -> ActionSpace:
         return DeltaPositionActions(max_delta=self.max_delta)
@@ -47,9 +48,7 @@ class BlockGraspEnvConfig(TaskEnvConfig):
     def make_task_env(self) -> TaskEnv:
         from lerobot_env_igen.block_grasp.env import BlockGraspEnv
 
-        return BlockGraspEnv(
-            corruption=self.corruption, reveal=self.reveal, cube_region=self.cube_region, max_delta=self.max_delta
-        )
+        return BlockGraspEnv(self)
 
     def make_scripted_operator(self) -> Operator:
         from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator

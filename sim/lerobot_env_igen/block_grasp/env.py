@@ -16,16 +16,19 @@ Paper setup (IntervenGen, Physical Block Grasp and its simulated twin):
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import mujoco
 import numpy as np
 
-from igen_lerobot.core.actions import DeltaPositionActions
-from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.error_models import ErrorModel
-from igen_lerobot.core.exceptions import ConfigError
-from lerobot_env_igen.block_grasp.spec import CUBE_HALF, LIFT_SUCCESS, SPEC, paper_corruption
+from lerobot_env_igen.block_grasp.spec import CUBE_HALF, LIFT_SUCCESS
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 from lerobot_env_igen.panda_task import PandaTaskEnv
-from lerobot_env_igen.scene import CUBE_RGBA, TABLE_TOP_Z, box
+from lerobot_env_igen.placement import RegionPlacer
+from lerobot_env_igen.scene import CUBE_RGBA, box
+
+if TYPE_CHECKING:
+    from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
 
 HOME_EEF_POS = (-0.05, 0.0, 1.0)  # [m] top-down home pose, 17.5 cm above the cube's top
 
@@ -33,37 +36,19 @@ HOME_EEF_POS = (-0.05, 0.0, 1.0)  # [m] top-down home pose, 17.5 cm above the cu
 class BlockGraspEnv(PandaTaskEnv):
     """The Block Grasp task on the compiled robosuite Panda scene."""
 
-    def __init__(
-        self,
-        corruption: ErrorModel | None = None,
-        reveal: Reveal = Reveal.FULL,
-        cube_region: tuple[float, float] = (0.20, 0.30),
-        cube_center: tuple[float, float] = (0.0, 0.0),
-        max_delta: float = 0.03,
-    ) -> None:
-        if min(cube_region) < 0:
-            raise ConfigError(f"env.cube_region must be non-negative (x, y) extents [m], got {cube_region}")
-        super().__init__(
-            spec=SPEC.with_reveal(reveal),
-            action_space=DeltaPositionActions(max_delta=max_delta),
-            error_model=corruption if corruption is not None else paper_corruption(),
-            objects=[box("cube", CUBE_HALF, CUBE_RGBA)],
-            home_pos=HOME_EEF_POS,
-        )
-        self.cube_region = np.asarray(cube_region, dtype=float)
-        self.cube_center = np.asarray(cube_center, dtype=float)
-        self.max_delta = float(max_delta)
+    def __init__(self, config: BlockGraspEnvConfig) -> None:
+        super().__init__(config, objects=[box("cube", CUBE_HALF, CUBE_RGBA)], home_pos=HOME_EEF_POS)
+        self._rest_z = TABLE_TOP_Z + CUBE_HALF
+        self.cube_placer = RegionPlacer("cube", config.region(), z=self._rest_z)
         self._cube_body = self.bodies["cube"]
         self._pad_ids = [
             mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, n)
             for n in (self.arm.names.left_pad, self.arm.names.right_pad)
         ]
         self._pads = self.arm.geom_mask(self._pad_ids)
-        self._rest_z = TABLE_TOP_Z + CUBE_HALF
 
     def place(self, rng: np.random.Generator) -> None:
-        xy = self.cube_center + rng.uniform(-0.5, 0.5, size=2) * self.cube_region
-        self.set_free_pose("cube", (xy[0], xy[1], self._rest_z))
+        self.cube_placer.place(self, rng)
 
     def set_cube_yaw(self, yaw: float) -> None:
         """Turn the resting cube about the vertical (perception tests need views of a rotated cube)."""

@@ -1,8 +1,8 @@
-"""A scripted grasp rule, used two ways.
+"""Block Grasp's scripted grasp rule and takeover rule (the agents: :mod:`lerobot_env_igen.scripted`).
 
-* :class:`ScriptedGraspOperator` applies it to the *true* cube pose: the embedded stand-in for a
-  person. It records full demonstrations, and in human-gated collection it takes over when it
-  judges the policy is making a mistake (rule in :meth:`ScriptedGraspOperator.judges_mistake`).
+* :class:`ScriptedGraspOperator` applies the rule to the *true* cube pose: the embedded stand-in
+  for a person. It records full demonstrations, and in human-gated collection it takes over when
+  it judges the policy is making a mistake (:func:`grasp_takeover`).
 * :class:`ScriptedGraspPolicy` applies it to the *observed* (possibly corrupted) cube pose: a
   base policy that trusts its perception, the embedded default before any policy is trained.
 
@@ -16,16 +16,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.core.agents import TakeoverOperator
-from igen_lerobot.core.task import TaskEnv
-from lerobot_env_igen.block_grasp.env import CUBE_HALF, BlockGraspEnv
+from igen_lerobot.core.actions import ActionSpace, DeltaPositionActions
+from lerobot_env_igen.block_grasp.spec import CUBE_HALF, SPEC
+from lerobot_env_igen.panda_spec import GRIPPER
+from lerobot_env_igen.scripted import OffAxisTakeover, ScriptedOperator, ScriptedPolicy, WaypointRule, clipped_step
 
 GRIPPER_OPEN_WIDTH = 0.078  # [m] fingers count as open above this
 HELD_WIDTH = 2 * CUBE_HALF + 0.006  # [m] closed on the cube (5 cm plus the pads' give)
 
 
 @dataclass(frozen=True)
-class GraspRule:
+class GraspRule(WaypointRule):
     """Waypoint rule for a top-down grasp; distances [m], speeds [m per 50 ms step]."""
 
     hover: float = 0.08  # height above the cube centre to travel at
@@ -36,7 +37,12 @@ class GraspRule:
     travel_speed: float = 0.02
     descend_speed: float = 0.012
 
-    def act(self, eef: np.ndarray, width: float, cube: np.ndarray) -> np.ndarray:
+    def act(
+        self, T_world_eef: np.ndarray, width: float, T_world_obj: dict[str, np.ndarray], actions: ActionSpace
+    ) -> np.ndarray:
+        return self.grasp_action(T_world_eef[:3, 3], width, T_world_obj["cube"][:3, 3])
+
+    def grasp_action(self, eef: np.ndarray, width: float, cube: np.ndarray) -> np.ndarray:
         """Action (dx, dy, dz, gripper) from the end-effector position, finger width and cube position."""
         xy_err = cube[:2] - eef[:2]
         xy_dist = float(np.linalg.norm(xy_err))
@@ -59,52 +65,36 @@ class GraspRule:
 
     @staticmethod
     def _move(eef: np.ndarray, target: np.ndarray, speed: float, close: bool) -> np.ndarray:
-        delta = target - eef
-        norm = float(np.linalg.norm(delta))
-        if norm > speed:
-            delta *= speed / norm
-        return np.array([*delta, 1.0 if close else -1.0])
+        # the action is the position step itself (no round trip through a goal pose)
+        return np.array([*clipped_step(eef, target, speed), 1.0 if close else -1.0])
 
 
-class ScriptedGraspPolicy:
+def grasp_takeover(mistake_xy: float = 0.010) -> OffAxisTakeover:
+    """When a person takes over: at the first sign of a mistake, for the rest of the episode.
+
+    The signs: a gripper-cube contact while the grip site is more than ``mistake_xy`` [m] off the
+    cube's axis in the table plane, the fingers closing off that axis, or the grip site less than
+    1 cm above the cube's top while off it (a miss without contact).
+    """
+    return OffAxisTakeover(
+        moving=GRIPPER,
+        target="cube",
+        mistake_xy=mistake_xy,
+        target_top=CUBE_HALF,
+        low_margin=0.01,
+        closing_width=GRIPPER_OPEN_WIDTH,
+    )
+
+
+class ScriptedGraspPolicy(ScriptedPolicy):
     """Base policy: the grasp rule on the observed cube pose (trusts its perception)."""
 
     def __init__(self, rule: GraspRule | None = None) -> None:
-        self.rule = rule or GraspRule()
-
-    def reset(self) -> None:
-        """Stateless."""
-
-    def act(self, observation: dict[str, np.ndarray]) -> np.ndarray:
-        state = observation["observation.state"]
-        env_state = observation["observation.environment_state"]
-        return self.rule.act(state[:3].astype(float), float(state[7]), env_state[:3].astype(float))
+        super().__init__(rule or GraspRule(), SPEC, DeltaPositionActions())
 
 
-class ScriptedGraspOperator(TakeoverOperator):
-    """Operator that sees the true cube pose.
-
-    Takes over (and keeps control to the end of the episode) at the first sign of a mistake:
-    a gripper-cube contact while the gripper is off the cube's grasp axis, the gripper closing
-    off that axis, or the fingertips below the cube's top while off it (a miss without contact).
-    "Off the axis" means more than ``mistake_xy`` [m] from the cube centre in the table plane.
-    A policy that has not grasped after ``patience_steps`` (it wanders) is taken over too.
-    """
+class ScriptedGraspOperator(ScriptedOperator):
+    """Operator that sees the true cube pose; takes over on :func:`grasp_takeover`, or after ``patience_steps``."""
 
     def __init__(self, rule: GraspRule | None = None, mistake_xy: float = 0.010, patience_steps: int = 100) -> None:
-        super().__init__(patience_steps)
-        self.rule = rule or GraspRule()
-        self.mistake_xy = mistake_xy
-
-    def judges_mistake(self, env: BlockGraspEnv) -> bool:
-        eef = env.eef_pose()[:3, 3]
-        cube = env.true_object_poses()["cube"][:3, 3]
-        off_axis = float(np.linalg.norm(cube[:2] - eef[:2])) > self.mistake_xy
-        below_top = eef[2] < cube[2] + CUBE_HALF + 0.01
-        closing = env.gripper_width() < GRIPPER_OPEN_WIDTH
-        return off_axis and (env.contact or closing or below_top)
-
-    def act(self, env: TaskEnv) -> np.ndarray:
-        eef = env.eef_pose()[:3, 3]
-        cube = env.true_object_poses()["cube"][:3, 3]
-        return self.rule.act(eef, env.gripper_width(), cube)
+        super().__init__(rule or GraspRule(), grasp_takeover(mistake_xy), patience_steps)

@@ -6,19 +6,18 @@ from dataclasses import dataclass, field
 
 from lerobot.envs.configs import EnvConfig
 
-from igen_lerobot.core.actions import ActionSpace, DeltaPoseActions
-from igen_lerobot.core.agents import Operator, Policy
 from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.error_models import ErrorModel
 from igen_lerobot.core.paper import VARIANTS, PaperTable
 from igen_lerobot.core.task import TaskEnv
-from lerobot_env_igen.nut_insertion.spec import SPEC, paper_corruption
+from lerobot_env_igen.config_in_hand_insertion import InHandInsertionEnvConfig
+from lerobot_env_igen.nut_insertion.spec import GEOMETRY, SPEC, paper_corruption
+from lerobot_env_igen.placement import UniformRegion
 
 
 @EnvConfig.register_subclass("nut_insertion")
 @dataclass
-class NutInsertionEnvConfig(TaskEnvConfig):
+class NutInsertionEnvConfig(InHandInsertionEnvConfig):
     """Nut Insertion with the paper's peg position error (+-4 cm per axis, at least 2 cm in one).
 
     Examples: ``lerobot-eval --env.type=nut_insertion --policy.path=.../pretrained_model``;
@@ -26,6 +25,7 @@ class NutInsertionEnvConfig(TaskEnvConfig):
     """
 
     base_spec = SPEC
+    geometry = GEOMETRY
     paper_tables = (
         PaperTable(
             reveal=Reveal.FULL,
@@ -50,33 +50,13 @@ class NutInsertionEnvConfig(TaskEnvConfig):
     )
 
     task: str | None = "NutInsertion-v0"
-    fps: int = SPEC.fps
-    episode_length: int = SPEC.max_episode_steps
     corruption: ErrorModel = field(default_factory=paper_corruption)
     peg_region: tuple[float, float] = (0.10, 0.10)  # [m] x, y extents of the peg's region
-    max_delta: float = 0.03  # [m] per-step clip on the commanded end-effector displacement
-    max_rotation: float = 0.2  # [rad] per-step clip on the commanded end-effector rotation
 
-    def make_action_space(self) -> ActionSpace:
-        return DeltaPoseActions(max_delta=self.max_delta, max_rotation=self.max_rotation)
+    def region(self) -> UniformRegion:
+        return UniformRegion(self.peg_region, flag="env.peg_region")
 
     def make_task_env(self) -> TaskEnv:
         from lerobot_env_igen.nut_insertion.env import NutInsertionEnv
 
-        return NutInsertionEnv(
-            corruption=self.corruption,
-            reveal=self.reveal,
-            peg_region=self.peg_region,
-            max_delta=self.max_delta,
-            max_rotation=self.max_rotation,
-        )
-
-    def make_scripted_operator(self) -> Operator:
-        from lerobot_env_igen.nut_insertion.scripted import ScriptedInsertionOperator
-
-        return ScriptedInsertionOperator()
-
-    def make_scripted_policy(self) -> Policy:
-        from lerobot_env_igen.nut_insertion.scripted import ScriptedInsertionPolicy
-
-        return ScriptedInsertionPolicy(max_delta=self.max_delta, max_rotation=self.max_rotation)
+        return NutInsertionEnv(self)

@@ -15,32 +15,23 @@ mean position of that first contact). 6-DOF delta-pose actions at 20 Hz.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from igen_lerobot.core.actions import DeltaPoseActions
-from igen_lerobot.core.belief import Reveal
-from igen_lerobot.core.error_models import ErrorModel
-from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.geometry import rot_z
-from lerobot_env_igen.nut_insertion.spec import (
-    NUT_HANDLE_GRIP_X,
-    ON_PEG_XY,
-    ON_PEG_Z,
-    PEG_CENTER_Z,
-    PEG_HALF,
-    SPEC,
-    TABLE_TOP_Z,
-    paper_corruption,
-)
-from lerobot_env_igen.panda import TOP_DOWN_ROT
-from lerobot_env_igen.panda_task import GRIPPER, PandaTaskEnv
+from lerobot_env_igen.in_hand_insertion import InHandInsertionEnv
+from lerobot_env_igen.nut_insertion.spec import NUT_HANDLE_GRIP_X, ON_PEG_XY, ON_PEG_Z, PEG_HALF
+from lerobot_env_igen.panda_spec import TABLE_TOP_Z
 from lerobot_env_igen.scene import box
+
+if TYPE_CHECKING:
+    from lerobot_env_igen.nut_insertion.config import NutInsertionEnvConfig
 
 HOME_EEF_POS = (-0.062, 0.0, 1.0)  # [m] with the nut held, its centre is over the region's centre, 6 cm above the peg
 NUT_YAW = np.pi  # the handle points back towards the robot
 PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site
 HANDLE_HALF_WIDTH = 0.015875  # [m]
-SETTLE_STEPS = 5  # control periods the closed fingers get to settle on the handle at reset
 PEG_RGBA = (0.55, 0.55, 0.6, 1.0)
 
 
@@ -51,45 +42,20 @@ def square_nut():
     return SquareNutObject(name="nut")
 
 
-class NutInsertionEnv(PandaTaskEnv):
+class NutInsertionEnv(InHandInsertionEnv):
     """The Nut Insertion task on the compiled robosuite Panda scene."""
 
-    def __init__(
-        self,
-        corruption: ErrorModel | None = None,
-        reveal: Reveal = Reveal.FULL,
-        peg_region: tuple[float, float] = (0.10, 0.10),
-        peg_center: tuple[float, float] = (0.0, 0.0),
-        max_delta: float = 0.03,
-        max_rotation: float = 0.2,
-    ) -> None:
-        if min(peg_region) < 0:
-            raise ConfigError(f"env.peg_region must be non-negative (x, y) extents [m], got {peg_region}")
-        super().__init__(
-            spec=SPEC.with_reveal(reveal),
-            action_space=DeltaPoseActions(max_delta=max_delta, max_rotation=max_rotation),
-            error_model=corruption if corruption is not None else paper_corruption(),
-            objects=[square_nut(), box("peg", PEG_HALF, PEG_RGBA, fixed=True)],
-            home_pos=HOME_EEF_POS,
-        )
-        self.peg_region = np.asarray(peg_region, dtype=float)
-        self.peg_center = np.asarray(peg_center, dtype=float)
+    def __init__(self, config: NutInsertionEnvConfig) -> None:
+        super().__init__(config, square_nut(), box("peg", PEG_HALF, PEG_RGBA, fixed=True), HOME_EEF_POS)
 
-    def place(self, rng: np.random.Generator) -> None:
-        xy = self.peg_center + rng.uniform(-0.5, 0.5, size=2) * self.peg_region
-        self.set_fixed_pose("peg", (xy[0], xy[1], PEG_CENTER_Z))
-        # the nut in the hand: fingers across the handle, the pads' centres at the handle's mid-height
+    def place_in_hand(self, rng: np.random.Generator) -> None:
+        # fingers across the handle, the pads' centres at the handle's mid-height
         grip = self.arm.eef_pos()
         rot = rot_z(NUT_YAW)
         centre = grip - rot @ np.array([NUT_HANDLE_GRIP_X, 0.0, 0.0]) + np.array([0.0, 0.0, PAD_ABOVE_GRIP])
         half = NUT_YAW / 2
         self.set_free_pose("nut", centre, (np.cos(half), 0.0, 0.0, np.sin(half)))
         self.arm.hold_closed(HANDLE_HALF_WIDTH + 0.0006)
-
-    def settle(self) -> None:
-        home = self.arm.eef_pos()
-        for _ in range(SETTLE_STEPS):
-            self.arm.control_period(home, True, TOP_DOWN_ROT)
 
     # ------------------------------------------------------------------ judges
     def nut_on_peg(self) -> bool:
@@ -99,9 +65,5 @@ class NutInsertionEnv(PandaTaskEnv):
         near = abs(nut[0] - peg[0]) < ON_PEG_XY and abs(nut[1] - peg[1]) < ON_PEG_XY
         return bool(near and nut[2] < TABLE_TOP_Z + ON_PEG_Z)
 
-    def released(self) -> bool:
-        """No part of the hand touches the nut."""
-        return not self.parts_in_contact(GRIPPER, "nut")
-
-    def is_success(self) -> bool:
-        return self.nut_on_peg() and self.released()
+    def inserted(self) -> bool:
+        return self.nut_on_peg()
