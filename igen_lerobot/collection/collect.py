@@ -92,7 +92,7 @@ def collect(cfg: CollectConfig) -> None:
         env.close()
         if viz is not None:
             viz.close()
-    summary = builder.finalize(
+    built = builder.write(
         cfg.num_episodes,
         metadata={
             "created_by": "igen-collect",
@@ -103,7 +103,13 @@ def collect(cfg: CollectConfig) -> None:
             "env": draccus.encode(env_cfg),
             "rejections": spool.rejection_reasons(),
         },
-        cameras=cfg.render,
     )
-    print(f"Wrote {summary.episodes} {cfg.mode} episodes ({summary.frames} frames) to {summary.root}")
-    cfg.dataset.publish(summary.root)
+    if cfg.render.cameras:
+        from igen_lerobot.datasets.render import render_dataset
+
+        # renders into <root>.partial/chunks, publishes <root> and removes the work folder
+        render_dataset(built.root, builder.root, builder.repo_id, cfg.render, overwrite=True)
+    else:
+        builder.publish()
+    print(f"Wrote {built.episodes} {cfg.mode} episodes ({built.frames} frames) to {builder.root}")
+    cfg.dataset.publish(builder.root)

@@ -112,7 +112,8 @@ def push_dataset(
     from huggingface_hub.errors import HfHubHTTPError
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from igen_lerobot.datasets.reader import dataset_spec, read_igen_meta
+    from igen_lerobot.datasets.meta import read_igen_meta
+    from igen_lerobot.datasets.reader import dataset_spec
 
     repo_id = check_repo_id(repo_id)
     root = Path(root)

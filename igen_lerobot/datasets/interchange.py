@@ -15,7 +15,8 @@ from tqdm import tqdm
 
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.datasets.config_interchange import ExportConfig, ImportConfig
-from igen_lerobot.datasets.reader import dataset_spec, load_episodes, read_igen_meta
+from igen_lerobot.datasets.meta import read_igen_meta
+from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 from igen_lerobot.datasets.robomimic import ImportSettings, count_demos, read_robomimic, write_robomimic
 from igen_lerobot.datasets.writer import DatasetBuilder
 
