@@ -17,7 +17,12 @@ from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.datasets.config_interchange import ExportConfig, ImportConfig
 from igen_lerobot.datasets.meta import read_igen_meta
 from igen_lerobot.datasets.reader import dataset_spec, load_episodes
-from igen_lerobot.datasets.robomimic import ImportSettings, count_demos, read_robomimic, write_robomimic
+from igen_lerobot.datasets.robomimic import (
+    ImportSettings,
+    count_demos,
+    read_robomimic,
+    write_robomimic,
+)
 from igen_lerobot.datasets.writer import DatasetBuilder
 
 logger = logging.getLogger(__name__)
@@ -61,8 +66,18 @@ def export_dataset(cfg: ExportConfig) -> dict:
         "env_kwargs": {"env_type": spec.name, "reveal": spec.reveal.value, "igen": read_igen_meta(root).meta},
     }
     progress = tqdm(episodes, desc="writing demos", unit="demo")
-    count = write_robomimic(Path(cfg.output), spec, env_cfg.make_action_space(), progress, env_args)
+    train, valid = write_robomimic(
+        Path(cfg.output), spec, env_cfg.make_action_space(), progress, env_args, cfg.valid_fraction, cfg.split_seed
+    )
     frames = sum(ep.length for ep in episodes)
     seconds = time.perf_counter() - start
+    count = len(train) + len(valid)
     print(f"Exported {count} episodes ({frames} frames) from {root} to {cfg.output}")
-    return {"episodes": count, "frames": frames, "seconds": seconds}
+    if valid:
+        print(f"Split: {len(train)} demos in mask/train, {len(valid)} in mask/valid ({', '.join(valid)})")
+    else:
+        print(
+            "Split: the one demo is in mask/train and mask/valid is empty: robomimic trains on it, but its "
+            "validation (experiment.validate=true, hdf5_validation_filter_key=valid) needs a second demo"
+        )
+    return {"episodes": count, "frames": frames, "seconds": seconds, "train": train, "valid": valid}
