@@ -20,6 +20,7 @@ from fake_task import FakeOperator, FakePickPlaceConfig
 from igen_lerobot.collection.record import record_demo
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.task import FrameSource
+from igen_lerobot.datasets.meta import read_igen_meta
 from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 from igen_lerobot.datasets.robomimic import IGEN_GROUP
 from igen_lerobot.datasets.writer import DatasetBuilder
@@ -106,6 +107,15 @@ def test_a_mimicgen_file_imports_in_demo_number_order_and_seeds_mimicgen(fake_de
     assert code == 0, err
     spec = dataset_spec(tmp_path / "imported")
     imported = load_episodes(tmp_path / "imported", spec)
+    # the file says only its env's name: robot and controller stay unknown (robosuite files name them)
+    assert read_igen_meta(tmp_path / "imported").meta["origin"] == {
+        "kind": "import",
+        "format": "robomimic",
+        "input": str(tmp_path / "mg.hdf5"),
+        "env_name": "PickPlace",
+        "robot": None,
+        "controller": None,
+    }
     order = sorted(range(6), key=lambda i: int(names[i].split("_")[1]))  # number order
     assert [ep.seed for ep in imported] == [int(names[i].split("_")[1]) for i in order]
     for ep, source in zip(imported, [episodes[i] for i in order], strict=True):
@@ -147,6 +157,9 @@ def test_ours_to_hdf5_and_back_gives_identical_episodes(fake_demos, tmp_path, so
         code, err = cli("igen-import", f"--input={out}", env, f"--dataset.root={back}")
         assert code == 0, err
         spec = dataset_spec(root)
+        origin = read_igen_meta(back).meta["origin"]
+        assert origin["kind"] == "import" and origin["env_name"] == spec.name
+        assert origin["exported_from"] == {"created_by": "test"}  # the exported dataset's own provenance
         before, after = load_episodes(root, spec), load_episodes(back, spec)
         assert len(before) == len(after)
         for a, b in zip(before, after, strict=True):

@@ -13,6 +13,7 @@ from igen_lerobot.core.agents import Operator
 from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.datasets.meta import simulation_origin
 from igen_lerobot.datasets.writer import DatasetBuilder
 from igen_lerobot.training.policy_source import make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
@@ -96,6 +97,7 @@ def collect(cfg: CollectConfig) -> None:
         cfg.num_episodes,
         metadata={
             "created_by": "igen-collect",
+            "origin": simulation_origin(env_cfg.task_spec.robot_type, env_cfg.package_name),
             "mode": cfg.mode,
             "seed": cfg.seed,
             "operator": cfg.operator,

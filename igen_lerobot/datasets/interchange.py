@@ -15,11 +15,12 @@ from tqdm import tqdm
 
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.datasets.config_interchange import ExportConfig, ImportConfig
-from igen_lerobot.datasets.meta import read_igen_meta
+from igen_lerobot.datasets.meta import import_origin, read_igen_meta
 from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 from igen_lerobot.datasets.robomimic import (
     ImportSettings,
     count_demos,
+    read_env_args,
     read_robomimic,
     write_robomimic,
 )
@@ -42,10 +43,14 @@ def import_dataset(cfg: ImportConfig) -> dict:
     builder = DatasetBuilder(root, repo_id, spec, overwrite=cfg.dataset.overwrite)
     for i, episode in enumerate(episodes):
         builder.spool.keep(i, episode)
-    summary = builder.finalize(
-        None,
-        {"created_by": "igen-import", "format": cfg.format, "input": str(cfg.input), "config": draccus.encode(cfg)},
-    )
+    metadata = {
+        "created_by": "igen-import",
+        "origin": import_origin(cfg.format, str(cfg.input), read_env_args(Path(cfg.input))),
+        "format": cfg.format,
+        "input": str(cfg.input),
+        "config": draccus.encode(cfg),
+    }
+    summary = builder.finalize(None, metadata)
     frames = sum(ep.length for ep in episodes)
     seconds = time.perf_counter() - start
     print(f"Imported {summary.episodes} episodes ({frames} frames) from {cfg.input} into {summary.root}")

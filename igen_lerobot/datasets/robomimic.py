@@ -49,6 +49,7 @@ __all__ = [
     "check_valid_fraction",
     "split_train_valid",
     "ImportSettings",
+    "read_env_args",
 ]
 
 _DEMO = re.compile(r"^demo_(\d+)$")
@@ -231,6 +232,19 @@ def count_demos(path: Path) -> int:
         if "data" not in file:
             raise DatasetSchemaError(f"--input={path} has no 'data' group: not a robomimic file")
         return len(demo_names(file["data"]))
+
+
+def read_env_args(path: Path) -> dict | None:
+    """The file's ``data.attrs["env_args"]`` (robomimic's env metadata), or None where it has none or it is no JSON."""
+    with _open(Path(path)) as file:
+        raw = file["data"].attrs.get("env_args") if "data" in file else None
+    if raw is None:
+        return None
+    try:
+        value = json.loads(raw.decode() if isinstance(raw, bytes) else str(raw))
+    except ValueError:
+        return None
+    return value if isinstance(value, dict) else None
 
 
 def check_valid_fraction(value: float, flag: str = "--valid_fraction") -> float:

@@ -13,6 +13,7 @@ from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.exceptions import DatasetSchemaError
 from igen_lerobot.datasets.merge import merge_datasets
+from igen_lerobot.datasets.meta import simulation_origin
 from igen_lerobot.datasets.reader import load_episodes
 from igen_lerobot.datasets.writer import DatasetBuilder
 from igen_lerobot.generation.attempt import Attempt
@@ -144,6 +145,7 @@ def generate(cfg: GenerateConfig) -> None:
         cfg.num_episodes,
         metadata={
             "created_by": "igen-generate",
+            "origin": simulation_origin(spec.robot_type, env_cfg.package_name),
             "mode": mode.value,
             "seed": cfg.seed,
             "source": str(source_root),
