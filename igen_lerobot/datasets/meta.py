@@ -7,11 +7,11 @@ reader, rendering, merging, interchange and the Hub card can all depend on it wi
 Besides the task, reveal mode, schema version and command, ``meta/igen.json`` says where the data
 came from under ``origin``:
 
-``{"kind": "simulation", "robot": "panda", "simulator": "MuJoCo 3.3.0", "task_package": ..., "controller": ...}``
+``{"kind": "simulation", "robot": "panda", "simulator": "MuJoCo 3.9.0", "task_package": ..., "controller": ...}``
     recorded or generated in a simulated task (``igen-collect``, ``igen-generate``);
 ``{"kind": "import", "format": "robomimic", "input": ..., "env_name": ..., "robot": ..., "controller": ...}``
     read from a file (``igen-import``): what the file's own metadata says about how it was recorded;
-``{"kind": "robot", "robot": ..., "controller": ...}``
+``{"kind": "robot", "robot": ..., "arm": ..., "controller": ...}``
     recorded on a robot (no command here writes it yet: the robot path records with ``lerobot-record``);
 ``{"kind": "merge", "source_kinds": ["simulation", "import"]}``
     joined from other datasets (``igen-merge``), each part's own origin in ``parts``.
@@ -32,7 +32,6 @@ from igen_lerobot.core.exceptions import DatasetSchemaError
 
 __all__ = [
     "IGEN_META_FILE",
-    "ORIGIN_KINDS",
     "DatasetInfo",
     "read_igen_meta",
     "running_command",
@@ -43,7 +42,6 @@ __all__ = [
 ]
 
 IGEN_META_FILE = "meta/igen.json"
-ORIGIN_KINDS = ("simulation", "import", "robot", "merge")
 # What executes an action in the tasks of igen's own simulator package: the action sets an end-effector
 # goal relative to the current pose (robosuite's delta semantics, igen_lerobot/core/actions.py) and the
 # simulated arm tracks it with robosuite's OSC_POSE law and gains (sim/lerobot_env_igen/osc.py).
