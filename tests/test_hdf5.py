@@ -20,6 +20,7 @@ from fake_task import FakeOperator, FakePickPlaceConfig
 from igen_lerobot.collection.record import record_demo
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.task import FrameSource
+from igen_lerobot.datasets.meta import read_igen_meta
 from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 from igen_lerobot.datasets.robomimic import IGEN_GROUP
 from igen_lerobot.datasets.writer import DatasetBuilder
@@ -106,6 +107,15 @@ def test_a_mimicgen_file_imports_in_demo_number_order_and_seeds_mimicgen(fake_de
     assert code == 0, err
     spec = dataset_spec(tmp_path / "imported")
     imported = load_episodes(tmp_path / "imported", spec)
+    # the file says only its env's name: robot and controller stay unknown (robosuite files name them)
+    assert read_igen_meta(tmp_path / "imported").meta["origin"] == {
+        "kind": "import",
+        "format": "robomimic",
+        "input": str(tmp_path / "mg.hdf5"),
+        "env_name": "PickPlace",
+        "robot": None,
+        "controller": None,
+    }
     order = sorted(range(6), key=lambda i: int(names[i].split("_")[1]))  # number order
     assert [ep.seed for ep in imported] == [int(names[i].split("_")[1]) for i in order]
     for ep, source in zip(imported, [episodes[i] for i in order], strict=True):
@@ -142,10 +152,14 @@ def test_ours_to_hdf5_and_back_gives_identical_episodes(fake_demos, tmp_path, so
             assert demo["datagen_info/eef_pose"].shape[1:] == (4, 4)
             assert ("states" in demo) == (root != tmp_path / "fake")
             assert f["data"].attrs["total"] == sum(f[f"data/{d}/actions"].shape[0] for d in f["data"])
+            check_robomimic_readable(f)
         back = tmp_path / f"{root.name}_back"
         code, err = cli("igen-import", f"--input={out}", env, f"--dataset.root={back}")
         assert code == 0, err
         spec = dataset_spec(root)
+        origin = read_igen_meta(back).meta["origin"]
+        assert origin["kind"] == "import" and origin["env_name"] == spec.name
+        assert origin["exported_from"] == {"created_by": "test"}  # the exported dataset's own provenance
         before, after = load_episodes(root, spec), load_episodes(back, spec)
         assert len(before) == len(after)
         for a, b in zip(before, after, strict=True):
@@ -157,6 +171,92 @@ def test_ours_to_hdf5_and_back_gives_identical_episodes(fake_demos, tmp_path, so
             assert (a.sim_state is None) == (b.sim_state is None) == (root.name.startswith("fake"))
             if a.sim_state is not None:  # the simulator states travel too (robomimic's "states")
                 np.testing.assert_array_equal(a.sim_state, b.sim_state)
+
+
+def robomimic_split(names, ratio, seed=0):
+    """robomimic 0.3.0's scripts/split_train_val.py, its split as written there (global seed, string sort)."""
+    demos = sorted(names)
+    num_val = int(ratio * len(demos))
+    mask = np.zeros(len(demos))
+    mask[:num_val] = 1.0
+    np.random.seed(seed)
+    np.random.shuffle(mask)
+    mask = mask.astype(int)
+    return [demos[i] for i in (1 - mask).nonzero()[0]], [demos[i] for i in mask.nonzero()[0]]
+
+
+def check_robomimic_readable(f, ratio=0.1, seed=0):
+    """What robomimic's SequenceDataset reads by default: next_obs beside obs, and the train/valid filter keys."""
+    names = sorted(f["data"])
+    for name in names:
+        demo = f[f"data/{name}"]
+        assert set(demo["next_obs"]) == set(demo["obs"])
+        for key in demo["obs"]:
+            obs, nxt = demo[f"obs/{key}"][()], demo[f"next_obs/{key}"][()]
+            assert nxt.shape == obs.shape and len(obs) == demo.attrs["num_samples"]
+            np.testing.assert_array_equal(nxt[:-1], obs[1:])  # the observation after each step
+            np.testing.assert_array_equal(nxt[-1], obs[-1])  # the last one repeated, as robomimic's converters do
+    train = [n.decode() for n in f["mask/train"][()]]
+    valid = [n.decode() for n in f["mask/valid"][()]]
+    assert sorted(train + valid) == names and not set(train) & set(valid)
+    if len(names) > 1:
+        assert valid and train
+        if int(ratio * len(names)) >= 1:  # where robomimic's own script gives a validation demo: its very split
+            assert (train, valid) == robomimic_split(names, ratio, seed)
+
+
+def test_the_split_is_robomimics_and_never_leaves_a_side_empty():
+    from igen_lerobot.core.exceptions import ConfigError
+    from igen_lerobot.datasets.robomimic import split_train_valid
+
+    for n, ratio, seed in [(10, 0.1, 0), (12, 0.1, 0), (25, 0.2, 3), (100, 0.1, 0), (7, 0.5, 1), (3, 0.34, 0)]:
+        names = [f"demo_{i}" for i in range(n)]
+        assert split_train_valid(names, ratio, seed) == robomimic_split(names, ratio, seed), (n, ratio, seed)
+    names = [f"demo_{i}" for i in range(4)]
+    train, valid = split_train_valid(names, 0.1)  # robomimic's script: int(0.4) = 0 validation demos
+    assert len(valid) == 1 and sorted(train + valid) == names
+    assert split_train_valid(["demo_0"], 0.1) == (["demo_0"], [])
+    for bad in (0.0, 1.0):
+        with pytest.raises(ConfigError, match=r"--valid_fraction=.* leaves mask/(valid|train) empty for 4 demos"):
+            split_train_valid(names, bad)
+
+
+def test_export_split_flags_and_a_one_demo_file(fake_demos, tmp_path, capsys):
+    config, episodes = fake_demos
+    root = tmp_path / "fake"
+    builder = DatasetBuilder(root, "local/fake", config.task_spec)
+    for i, ep in enumerate(episodes[:12]):
+        builder.spool.keep(i, ep)
+    builder.finalize(None, {"created_by": "test"})
+    out = tmp_path / "split.hdf5"
+    code, err = cli(
+        "igen-export", f"--dataset.root={root}", f"--output={out}", "--valid_fraction=0.25", "--split_seed=7"
+    )
+    assert code == 0, err
+    with h5py.File(out) as f:
+        check_robomimic_readable(f, ratio=0.25, seed=7)
+        split = ([n.decode() for n in f["mask/train"][()]], [n.decode() for n in f["mask/valid"][()]])
+    assert split == robomimic_split([f"demo_{i}" for i in range(12)], 0.25, seed=7) and len(split[1]) == 3
+    for bad in ("0", "1", "1.5", "-0.1"):
+        code, err = cli(
+            "igen-export", f"--dataset.root={root}", f"--output={tmp_path / 'bad.hdf5'}", f"--valid_fraction={bad}"
+        )
+        assert code == 2 and f"--valid_fraction={float(bad)} must be in (0, 1)" in err.strip().splitlines()[-1], err
+        assert not (tmp_path / "bad.hdf5").exists() and not (tmp_path / "bad.hdf5.partial").exists()
+    one = tmp_path / "one"
+    builder = DatasetBuilder(one, "local/one", config.task_spec)
+    builder.spool.keep(0, episodes[0])
+    builder.finalize(None, {"created_by": "test"})
+    capsys.readouterr()
+    code, err = cli("igen-export", f"--dataset.root={one}", f"--output={tmp_path / 'one.hdf5'}")
+    assert code == 0, err
+    assert "the one demo is in mask/train and mask/valid is empty" in capsys.readouterr().out
+    with h5py.File(tmp_path / "one.hdf5") as f:
+        check_robomimic_readable(f)
+        assert [n.decode() for n in f["mask/train"][()]] == ["demo_0"] and len(f["mask/valid"]) == 0
+    code, err = cli("igen-import", f"--input={tmp_path / 'one.hdf5'}", FAKE, f"--dataset.root={tmp_path / 'one_back'}")
+    assert code == 0, err
+    assert len(load_episodes(tmp_path / "one_back", config.task_spec)) == 1
 
 
 def test_bad_files_are_refused_with_the_reason_and_nothing_is_written(fake_demos, tmp_path):

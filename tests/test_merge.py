@@ -56,6 +56,9 @@ def test_weighted_merge_samples_interventions_as_often_as_the_base(source_demos,
     assert abs(share - target) < interventions.meta.total_frames / merged.meta.total_frames
     meta = json.loads((out / "meta" / "igen.json").read_text())
     assert [p["repeats"] for p in meta["parts"]] == [1, repeats]
+    # the fixtures record no origin (created_by "test"): the merge says so rather than guessing
+    assert [p["origin"] for p in meta["parts"]] == [{"kind": None}, {"kind": None}]
+    assert meta["origin"] == {"kind": "merge", "source_kinds": [None]}
     assert meta["episode_kinds"]["intervention"] == repeats * interventions.meta.total_episodes
 
 

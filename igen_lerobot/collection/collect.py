@@ -13,6 +13,7 @@ from igen_lerobot.core.agents import Operator
 from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.datasets.meta import simulation_origin
 from igen_lerobot.datasets.writer import DatasetBuilder
 from igen_lerobot.training.policy_source import make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
@@ -92,10 +93,11 @@ def collect(cfg: CollectConfig) -> None:
         env.close()
         if viz is not None:
             viz.close()
-    summary = builder.finalize(
+    built = builder.write(
         cfg.num_episodes,
         metadata={
             "created_by": "igen-collect",
+            "origin": simulation_origin(env_cfg.task_spec.robot_type, env_cfg.package_name),
             "mode": cfg.mode,
             "seed": cfg.seed,
             "operator": cfg.operator,
@@ -103,7 +105,13 @@ def collect(cfg: CollectConfig) -> None:
             "env": draccus.encode(env_cfg),
             "rejections": spool.rejection_reasons(),
         },
-        cameras=cfg.render,
     )
-    print(f"Wrote {summary.episodes} {cfg.mode} episodes ({summary.frames} frames) to {summary.root}")
-    cfg.dataset.publish(summary.root)
+    if cfg.render.cameras:
+        from igen_lerobot.datasets.render import render_dataset
+
+        # renders into <root>.partial/chunks, publishes <root> and removes the work folder
+        render_dataset(built.root, builder.root, builder.repo_id, cfg.render, overwrite=True)
+    else:
+        builder.publish()
+    print(f"Wrote {built.episodes} {cfg.mode} episodes ({built.frames} frames) to {builder.root}")
+    cfg.dataset.publish(builder.root)

@@ -3,7 +3,10 @@
 LeRobot's own card template frames it (its front matter: LeRobot tag, robotics category, the
 parquet config, the license; ``meta/info.json`` as the structure); everything a person needs to
 judge the data goes into the template's description and citation fields, built from the dataset's
-own files (``meta/info.json``, ``meta/igen.json``) and the task's spec.
+own files (``meta/info.json``, ``meta/igen.json``) and the task's spec. Where the data comes from
+(simulation, an imported file, a robot, a merge of those) and with which robot, simulator and
+controller is said only as ``meta/igen.json``'s ``origin`` records it (:mod:`igen_lerobot.datasets.meta`);
+what it does not record, the card calls unknown.
 """
 
 from __future__ import annotations
@@ -13,13 +16,16 @@ import shlex
 from pathlib import Path
 
 from igen_lerobot.core.task import TaskSpec
+from igen_lerobot.datasets.meta import origin_of, source_kinds
 from igen_lerobot.datasets.schema import SCHEMA_DOC_ROWS
 
-__all__ = ["card_fields", "CARD_TAGS", "PAPER_URL", "CITATIONS"]
+__all__ = ["card_fields", "card_tags", "CARD_TAGS", "SIMULATION_TAGS", "PAPER_URL", "CITATIONS"]
 
 PAPER_URL = "https://arxiv.org/abs/2405.01472"
 HOMEPAGE = "https://sites.google.com/view/intervengen2024"
-CARD_TAGS = ("synthetic", "simulation", "intervengen", "mimicgen", "interventions", "imitation-learning")
+CARD_TAGS = ("intervengen", "mimicgen", "interventions", "imitation-learning")  # every igen dataset
+SIMULATION_TAGS = ("synthetic", "simulation")  # only where all of the data comes from simulation
+NOT_RECORDED = "not recorded"
 CITATIONS = """@inproceedings{hoque2024intervengen,
   title     = {IntervenGen: Interventional Data Generation for Robust and Data-Efficient Robot Imitation Learning},
   author    = {Hoque, Ryan and Mandlekar, Ajay and Garrett, Caelan and Goldberg, Ken and Fox, Dieter},
@@ -63,19 +69,77 @@ def _table(rows: list[tuple[str, ...]]) -> list[str]:
     return [f"| {' | '.join(head)} |", f"|{'---|' * len(head)}", *[f"| {' | '.join(r)} |" for r in body]]
 
 
+def _kinds_text(kinds: list[str | None]) -> str:
+    return ", ".join("unknown" if k is None else k for k in kinds)
+
+
+def _recorded(origin: dict, key: str) -> str:
+    value = origin.get(key)
+    return f"`{value}`" if value else NOT_RECORDED
+
+
+def _origin_line(origin: dict, meta: dict, info: dict) -> str:
+    """One bullet saying where the data comes from, only as far as its metadata says."""
+    kind = origin.get("kind")
+    if kind == "simulation":
+        models = f", {origin['models']} models" if origin.get("models") else ""
+        return (
+            f"- **Source**: simulation (simulator: {_recorded(origin, 'simulator')}{models}; task package "
+            f"{_recorded(origin, 'task_package')}); robot {_recorded(origin, 'robot')}; controller: "
+            f"{origin.get('controller') or NOT_RECORDED}."
+        )
+    if kind == "import":
+        line = (
+            f"- **Source**: imported with `igen-import` from {_recorded(origin, 'input')} "
+            f"({origin.get('format') or 'format ' + NOT_RECORDED}). How that file was recorded, as far as its own "
+            f"metadata says: env {_recorded(origin, 'env_name')}, robot {_recorded(origin, 'robot')}, controller "
+            f"{_recorded(origin, 'controller')}; whether it was simulated or recorded on a robot is not known here. "
+            "The actions were recomputed from the file's end-effector target poses through this task's action space, "
+            f"and the robot type `{info.get('robot_type')}` above is this task's, not necessarily the recording's."
+        )
+        upstream = origin.get("exported_from")
+        if isinstance(upstream, dict):
+            kinds = _kinds_text(source_kinds(origin_of(upstream)))
+            line += f" The file is an `igen-export` of a dataset made by `{upstream.get('created_by')}` ({kinds})."
+        return line
+    if kind == "robot":
+        return (
+            f"- **Source**: recorded on a robot: {_recorded(origin, 'robot')} (arm {_recorded(origin, 'arm')}); "
+            f"controller: {origin.get('controller') or NOT_RECORDED}."
+        )
+    if kind == "merge":
+        parts = meta.get("parts") or []
+        return (
+            f"- **Source**: a merge of {len(parts)} datasets ({_kinds_text(source_kinds(origin))}); each part's "
+            'source is listed under "How it was made".'
+        )
+    return (
+        f"- **Source**: not recorded in meta/igen.json (made by `{meta.get('created_by') or 'unknown'}`): whether "
+        "the data was simulated, imported or recorded on a robot, and with which controller, is unknown "
+        f"(meta/info.json names robot type `{info.get('robot_type')}`)."
+    )
+
+
+def card_tags(spec: TaskSpec, meta: dict) -> list[str]:
+    """The card's tags: igen's, the task's name, and ``synthetic``/``simulation`` only for simulated data."""
+    simulated = source_kinds(origin_of(meta)) == ["simulation"]
+    return [*(SIMULATION_TAGS if simulated else ()), *CARD_TAGS, spec.name]
+
+
 def _made_by(meta: dict) -> list[str]:
     lines = []
     parts = meta.get("parts")
     if parts:  # a merge: describe each part
         lines.append(f"Made by `igen-merge` from {len(parts)} datasets (each part repeated as listed):")
         lines.append("")
-        rows = [("part", "made by", "mode", "seed", "repeats", "frames", "episodes per kind")]
+        rows = [("part", "made by", "source", "mode", "seed", "repeats", "frames", "episodes per kind")]
         for p in parts:
             kinds = ", ".join(f"{k} {v}" for k, v in (p.get("episode_kinds") or {}).items())
             rows.append(
                 (
                     f"`{p.get('root')}`",
                     str(p.get("created_by")),
+                    _kinds_text(source_kinds(origin_of(p))),
                     str(p.get("mode")),
                     str(p.get("seed")),
                     str(p.get("repeats")),
@@ -140,18 +204,20 @@ def card_fields(root: Path, spec: TaskSpec, info: dict, meta: dict, command: lis
     kinds = meta.get("episode_kinds") or {}
     total_eps, total_frames = info.get("total_episodes"), info.get("total_frames")
     reveal = meta.get("reveal", spec.reveal.value)
+    origin = origin_of(meta)
     lines = [
         f"**{spec.name}**, an [IntervenGen]({PAPER_URL}) dataset made with igen-lerobot: "
         f"{total_eps} episodes, {total_frames} frames at {info.get('fps', spec.fps)} Hz, "
-        f'robot `{info.get("robot_type", spec.robot_type)}`, instruction: "{spec.instruction}"',
+        f'robot type `{info.get("robot_type", spec.robot_type)}`, instruction: "{spec.instruction}"',
         "",
         "## What the data is",
         "",
+        _origin_line(origin, meta, info),
         f"- **Task**: {spec.name}; objects {', '.join(f'`{o}`' for o in spec.objects)}; subtasks "
         + ", ".join(f"`{s.name}` (relative to `{s.object_name}`)" for s in spec.subtasks)
         + ".",
         f"- **Action** ({len(spec.action_names)}): {', '.join(f'`{n}`' for n in spec.action_names)}. Deltas are "
-        "offsets of the controller's goal from the current end-effector pose (robosuite's OSC semantics): "
+        "offsets of the end-effector goal from the current end-effector pose (robosuite's OSC delta semantics): "
         "positions in metres, rotations as a world-frame axis-angle in radians; `gripper` −1 open, +1 close.",
         f"- **`observation.state`** ({len(spec.state_names)}): {', '.join(f'`{n}`' for n in spec.state_names)} "
         "(metres, quaternion x, y, z, w).",
@@ -177,28 +243,53 @@ def card_fields(root: Path, spec: TaskSpec, info: dict, meta: dict, command: lis
     ]
     if command:
         lines += ["", "Pushed with:", "", "```bash", shlex.join(command), "```"]
-    lines += [
-        "",
-        "## Limitations",
-        "",
-        "- Simulation only (MuJoCo physics with robosuite 1.5 models); the real robot differs in dynamics, "
-        "sensing and contact.",
-        "- Where the operator is `scripted`, the interventions come from a rule that sees the true poses, not "
-        "from a person: recoveries are more regular than human ones.",
-        "- Generated episodes replay transformed source segments open loop; only successful attempts are kept, "
-        "so the data says nothing about failure rates (see the generation success rate above).",
-        "",
-        "## License",
-        "",
-        "The data: Apache-2.0, as igen-lerobot. The robot and object models it was simulated with come from "
-        "robosuite (MIT).",
-    ]
+    lines += ["", "## Limitations", "", *_limitations(origin), "", "## License", "", _license(origin, meta)]
     return {
         "dataset_description": "\n".join(lines),
         "url": HOMEPAGE,
         "paper": PAPER_URL,
         "citation_bibtex": CITATIONS,
     }
+
+
+def _limitations(origin: dict) -> list[str]:
+    kinds = source_kinds(origin)
+    lines = []
+    if kinds == ["simulation"]:
+        lines.append(
+            "- Simulation only; a real robot differs in dynamics, sensing and contact."
+            if origin.get("kind") != "simulation"
+            else f"- Simulation only ({origin.get('simulator') or 'simulator ' + NOT_RECORDED}"
+            + (f" with {origin['models']} models" if origin.get("models") else "")
+            + "); a real robot differs in dynamics, sensing and contact."
+        )
+    if "import" in kinds:
+        lines.append(
+            "- Imported episodes are what the source file holds: how it was recorded is known only as far as its "
+            "metadata says (above), and their actions were recomputed from its target poses, clipped to this "
+            "task's per-step limits."
+        )
+    if None in kinds:
+        lines.append(
+            "- Where the data comes from is not recorded for some or all of it: treat its robot, simulator and "
+            "controller as unknown."
+        )
+    lines += [
+        "- Where the operator is `scripted`, the interventions come from a rule that sees the true poses, not "
+        "from a person: recoveries are more regular than human ones.",
+        "- Generated episodes replay transformed source segments open loop; only successful attempts are kept, "
+        "so the data says nothing about failure rates (see the generation success rate above).",
+    ]
+    return lines
+
+
+def _license(origin: dict, meta: dict) -> str:
+    text = "The data: Apache-2.0, as igen-lerobot."
+    if origin.get("kind") == "simulation" and str(origin.get("models", "")).startswith("robosuite"):
+        text += " The robot and object models it was simulated with come from robosuite (MIT)."
+    if "import" in source_kinds(origin):
+        text += " Imported episodes come from another file: its own terms (and its authors') apply to them too."
+    return text
 
 
 def _cameras_line(info: dict, meta: dict) -> str:

@@ -10,6 +10,7 @@ from lerobot.envs.configs import EnvConfig
 from igen_lerobot.core.env_config import resolve_task_env
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
+from igen_lerobot.datasets.robomimic import VALID_FRACTION, check_valid_fraction
 
 FORMATS = ("robomimic",)  # robomimic's layout, with MimicGen's datagen_info
 
@@ -54,9 +55,14 @@ class ExportConfig:
     dataset: ExportSourceConfig = field(default_factory=ExportSourceConfig)
     output: str | None = None  # the .hdf5 file to write
     overwrite: bool = False
+    # share of demos in mask/valid, the rest in mask/train (robomimic's split_train_val.py; at least one
+    # validation demo when there are two or more)
+    valid_fraction: float = VALID_FRACTION
+    split_seed: int = 0  # the split's shuffle seed (robomimic's script seeds 0)
 
     def __post_init__(self) -> None:
         _check_format(self.format)
+        check_valid_fraction(self.valid_fraction)
         if not self.dataset.root:
             raise ConfigError("--dataset.root is required: the igen dataset to export")
         if not self.output:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import ConfigError, IgenError
-from igen_lerobot.datasets.card import CARD_TAGS, card_fields
+from igen_lerobot.datasets.card import card_fields, card_tags
 
 logger = logging.getLogger(__name__)
 
@@ -112,7 +112,8 @@ def push_dataset(
     from huggingface_hub.errors import HfHubHTTPError
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from igen_lerobot.datasets.reader import dataset_spec, read_igen_meta
+    from igen_lerobot.datasets.meta import read_igen_meta
+    from igen_lerobot.datasets.reader import dataset_spec
 
     repo_id = check_repo_id(repo_id)
     root = Path(root)
@@ -122,7 +123,7 @@ def push_dataset(
     dataset = LeRobotDataset(repo_id, root=root)
     dataset.revision = None  # branches start from the default branch, not from a tag a new repo lacks
     fields = card_fields(root, spec, dataset.meta.info.to_dict(), meta, command or sys.argv)
-    tags = [*CARD_TAGS, spec.name]
+    tags = card_tags(spec, meta)
     try:
         with _cards_validated_at_endpoint():
             dataset.push_to_hub(

@@ -15,8 +15,15 @@ from tqdm import tqdm
 
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.datasets.config_interchange import ExportConfig, ImportConfig
-from igen_lerobot.datasets.reader import dataset_spec, load_episodes, read_igen_meta
-from igen_lerobot.datasets.robomimic import ImportSettings, count_demos, read_robomimic, write_robomimic
+from igen_lerobot.datasets.meta import import_origin, read_igen_meta
+from igen_lerobot.datasets.reader import dataset_spec, load_episodes
+from igen_lerobot.datasets.robomimic import (
+    ImportSettings,
+    count_demos,
+    read_env_args,
+    read_robomimic,
+    write_robomimic,
+)
 from igen_lerobot.datasets.writer import DatasetBuilder
 
 logger = logging.getLogger(__name__)
@@ -36,10 +43,14 @@ def import_dataset(cfg: ImportConfig) -> dict:
     builder = DatasetBuilder(root, repo_id, spec, overwrite=cfg.dataset.overwrite)
     for i, episode in enumerate(episodes):
         builder.spool.keep(i, episode)
-    summary = builder.finalize(
-        None,
-        {"created_by": "igen-import", "format": cfg.format, "input": str(cfg.input), "config": draccus.encode(cfg)},
-    )
+    metadata = {
+        "created_by": "igen-import",
+        "origin": import_origin(cfg.format, str(cfg.input), read_env_args(Path(cfg.input))),
+        "format": cfg.format,
+        "input": str(cfg.input),
+        "config": draccus.encode(cfg),
+    }
+    summary = builder.finalize(None, metadata)
     frames = sum(ep.length for ep in episodes)
     seconds = time.perf_counter() - start
     print(f"Imported {summary.episodes} episodes ({frames} frames) from {cfg.input} into {summary.root}")
@@ -60,8 +71,18 @@ def export_dataset(cfg: ExportConfig) -> dict:
         "env_kwargs": {"env_type": spec.name, "reveal": spec.reveal.value, "igen": read_igen_meta(root).meta},
     }
     progress = tqdm(episodes, desc="writing demos", unit="demo")
-    count = write_robomimic(Path(cfg.output), spec, env_cfg.make_action_space(), progress, env_args)
+    train, valid = write_robomimic(
+        Path(cfg.output), spec, env_cfg.make_action_space(), progress, env_args, cfg.valid_fraction, cfg.split_seed
+    )
     frames = sum(ep.length for ep in episodes)
     seconds = time.perf_counter() - start
+    count = len(train) + len(valid)
     print(f"Exported {count} episodes ({frames} frames) from {root} to {cfg.output}")
-    return {"episodes": count, "frames": frames, "seconds": seconds}
+    if valid:
+        print(f"Split: {len(train)} demos in mask/train, {len(valid)} in mask/valid ({', '.join(valid)})")
+    else:
+        print(
+            "Split: the one demo is in mask/train and mask/valid is empty: robomimic trains on it, but its "
+            "validation (experiment.validate=true, hdf5_validation_filter_key=valid) needs a second demo"
+        )
+    return {"episodes": count, "frames": frames, "seconds": seconds, "train": train, "valid": valid}

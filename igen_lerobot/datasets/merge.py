@@ -20,9 +20,10 @@ from pathlib import Path
 from igen_lerobot.core.exceptions import ConfigError, TaskMismatchError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_merge import MergeConfig
-from igen_lerobot.datasets.reader import check_features, dataset_spec, read_igen_meta
+from igen_lerobot.datasets.meta import IGEN_META_FILE, origin_of, read_igen_meta, running_command
+from igen_lerobot.datasets.reader import check_features, dataset_spec
 from igen_lerobot.datasets.schema import RL_COLUMNS, SCHEMA_VERSION, SIM_STATE
-from igen_lerobot.datasets.writer import IGEN_META_FILE, running_command, write_lerobot_dataset
+from igen_lerobot.datasets.writer import write_lerobot_dataset
 
 logger = logging.getLogger(__name__)
 
@@ -134,10 +135,12 @@ def merge_datasets(
                 "repeats": n,
                 "frames": f,
                 **{k: m.get(k) for k in ("created_by", "mode", "seed", "episode_kinds")},
+                "origin": origin_of(m),
             }
             for r, m, n, f in zip(roots, metas, repeats, frames, strict=True)
         ],
     }
+    merged["origin"] = origin_of(merged)  # the kinds of its parts; each part's own origin is in parts
     (build / IGEN_META_FILE).write_text(json.dumps(merged, indent=2, default=str))
     if output_root.exists():
         shutil.rmtree(output_root)

@@ -8,7 +8,6 @@ intervention flags, a column of the wrong shape.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +15,7 @@ import numpy as np
 from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.exceptions import DatasetSchemaError, TaskMismatchError
 from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskSpec
+from igen_lerobot.datasets.meta import DatasetInfo, read_igen_meta
 from igen_lerobot.datasets.schema import (
     CORRUPTION,
     EPISODE_KIND,
@@ -29,33 +29,8 @@ from igen_lerobot.datasets.schema import (
     TRUE_OBJECT_POSE,
     dataset_features,
 )
-from igen_lerobot.datasets.writer import IGEN_META_FILE
 
-
-@dataclass(frozen=True)
-class DatasetInfo:
-    """The igen facts of a dataset on disk."""
-
-    root: Path
-    task: str
-    meta: dict
-
-
-def read_igen_meta(root: Path, flag: str = "--dataset.root") -> DatasetInfo:
-    """The task and provenance recorded in ``meta/igen.json``; ``flag`` is the option that named ``root``."""
-    root = Path(root)
-    if not (root / "meta" / "info.json").exists():
-        partial = root.with_name(root.name + ".partial")
-        hint = f" ({partial} holds an unfinished run: rerun its command to complete it)" if partial.exists() else ""
-        raise DatasetSchemaError(f"{root} is not a LeRobot dataset (meta/info.json missing){hint}; check {flag}")
-    path = root / IGEN_META_FILE
-    if not path.exists():
-        raise DatasetSchemaError(
-            f"{root} is a LeRobot dataset without igen metadata ({IGEN_META_FILE} missing), so it has no "
-            f"intervention flags to trust; record it with igen-collect or igen-generate"
-        )
-    meta = json.loads(path.read_text())
-    return DatasetInfo(root=root, task=meta["task"], meta=meta)
+__all__ = ["DatasetInfo", "read_igen_meta", "dataset_spec", "check_features", "load_episodes"]
 
 
 def dataset_spec(root: Path, flag: str = "--dataset.root") -> TaskSpec:

@@ -26,14 +26,10 @@ from igen_lerobot.core.cameras import CameraConfig, image_key, render_images
 from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError
 from igen_lerobot.core.task import TaskSpec
 from igen_lerobot.datasets.config_render import RenderConfig
-from igen_lerobot.datasets.reader import dataset_spec, read_igen_meta
+from igen_lerobot.datasets.meta import IGEN_META_FILE, read_igen_meta, running_command
+from igen_lerobot.datasets.reader import dataset_spec
 from igen_lerobot.datasets.schema import SIM_STATE, dataset_features, episode_frames
-from igen_lerobot.datasets.writer import (
-    IGEN_META_FILE,
-    running_command,
-    sim_state_stats_skipped,
-    task_sim_state_layout,
-)
+from igen_lerobot.datasets.writer import sim_state_stats_skipped, task_sim_state_layout
 
 logger = logging.getLogger(__name__)
 

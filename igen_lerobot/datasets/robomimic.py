@@ -6,6 +6,18 @@ MimicGen adds ``data/demo_<i>/datagen_info/{eef_pose, target_pose, gripper_actio
 object_poses/<object>, subtask_term_signals/<signal>}``: 4x4 poses and the per-step signals that
 cut a demonstration into object-centric subtasks.
 
+Writing makes a file robomimic's own training reads (``robomimic.utils.dataset.SequenceDataset``
+with its defaults, ``load_next_obs=True``, and the ``train``/``valid`` filter keys):
+
+* ``next_obs/<key>`` is ``obs/<key>`` shifted by one step with the last step repeated, as
+  robomimic's conversion scripts write it for data whose final next observation was not recorded
+  (``scripts/conversion/convert_d4rl.py``: the last step's ``next_obs`` is a copy of its ``obs``);
+* ``mask/train`` and ``mask/valid`` split the demos as robomimic's ``scripts/split_train_val.py``
+  does (names sorted as strings, ``int(fraction * n)`` validation demos chosen by shuffling a 0/1
+  mask with ``np.random.seed(seed)``), except that a file of two or more demos always gets at least
+  one validation demo (robomimic's script leaves ``valid`` empty below ``1 / fraction`` demos). A
+  file of one demo has it in ``train`` and an empty ``valid``.
+
 Reading builds our episodes from ``datagen_info``: the robot state from the end-effector pose and
 the gripper's finger positions, the actions from the target poses through the task's own action
 space (so they mean what our env's actions mean), the object poses as truth and belief (source
@@ -26,14 +38,24 @@ import numpy as np
 
 from igen_lerobot.core.actions import ActionSpace
 from igen_lerobot.core.episode import Episode, EpisodeKind
-from igen_lerobot.core.exceptions import DatasetSchemaError
+from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError
 from igen_lerobot.core.geometry import pos_quat_to_pose, pose_vector
 from igen_lerobot.core.task import FrameSource, TaskSpec
 
-__all__ = ["read_robomimic", "write_robomimic", "demo_names", "ImportSettings"]
+__all__ = [
+    "read_robomimic",
+    "write_robomimic",
+    "demo_names",
+    "check_valid_fraction",
+    "split_train_valid",
+    "ImportSettings",
+    "read_env_args",
+]
 
 _DEMO = re.compile(r"^demo_(\d+)$")
 IGEN_GROUP = "igen"  # our own per-demo group: the exact episode, for lossless round trips
+OBS_KEYS = ("robot0_eef_pos", "robot0_eef_quat", "robot0_gripper_qpos", "object")  # what we write under obs/
+VALID_FRACTION = 0.1  # robomimic's split_train_val.py default
 EPISODE_ARRAYS = (
     "corruption", "state", "env_state", "action", "is_intervention", "source", "subtask", "true_object_pose"
 )  # fmt: skip
@@ -212,13 +234,75 @@ def count_demos(path: Path) -> int:
         return len(demo_names(file["data"]))
 
 
-def write_robomimic(path: Path, spec: TaskSpec, actions: ActionSpace, episodes, env_args: dict) -> int:
+def read_env_args(path: Path) -> dict | None:
+    """The file's ``data.attrs["env_args"]`` (robomimic's env metadata), or None where it has none or it is no JSON."""
+    with _open(Path(path)) as file:
+        raw = file["data"].attrs.get("env_args") if "data" in file else None
+    if raw is None:
+        return None
+    try:
+        value = json.loads(raw.decode() if isinstance(raw, bytes) else str(raw))
+    except ValueError:
+        return None
+    return value if isinstance(value, dict) else None
+
+
+def check_valid_fraction(value: float, flag: str = "--valid_fraction") -> float:
+    """A validation fraction in (0, 1), or an error naming ``flag`` (0 or 1 would leave a side empty)."""
+    if not 0.0 < float(value) < 1.0:
+        raise ConfigError(
+            f"{flag}={value} must be in (0, 1): the share of demos in mask/valid (robomimic's default "
+            f"{VALID_FRACTION}); 0 would leave mask/valid empty and 1 mask/train"
+        )
+    return float(value)
+
+
+def split_train_valid(
+    names: list[str], valid_fraction: float = VALID_FRACTION, seed: int = 0, flag: str = "--valid_fraction"
+) -> tuple[list[str], list[str]]:
+    """``(train, valid)`` demo names, split as robomimic's ``split_train_val.py`` splits them.
+
+    Names are sorted as strings and ``int(valid_fraction * n)`` of them (at least one when
+    there are two or more) are picked by shuffling a 0/1 mask with ``np.random.RandomState(seed)``:
+    with the same count, the same split robomimic's script makes after ``np.random.seed(seed)``.
+    A fraction that leaves either side empty with more than one demo is refused, naming ``flag``;
+    a single demo goes to ``train`` and ``valid`` is empty.
+    """
+    demos = sorted(names)
+    n = len(demos)
+    if n <= 1:
+        return demos, []
+    count = max(1, int(valid_fraction * n)) if valid_fraction > 0 else 0
+    if count == 0 or count >= n:
+        side = "mask/valid" if count == 0 else "mask/train"
+        raise ConfigError(
+            f"{flag}={valid_fraction} leaves {side} empty for {n} demos; give a fraction in (0, 1) "
+            f"(robomimic's default is {VALID_FRACTION}): the file gets max(1, int(fraction * {n})) validation demos"
+        )
+    mask = np.zeros(n)
+    mask[:count] = 1.0
+    np.random.RandomState(seed).shuffle(mask)
+    return [d for d, m in zip(demos, mask, strict=True) if not m], [d for d, m in zip(demos, mask, strict=True) if m]
+
+
+def write_robomimic(
+    path: Path,
+    spec: TaskSpec,
+    actions: ActionSpace,
+    episodes,
+    env_args: dict,
+    valid_fraction: float = VALID_FRACTION,
+    split_seed: int = 0,
+) -> tuple[list[str], list[str]]:
     """Write ``episodes`` in robomimic's layout with MimicGen's ``datagen_info`` (and our ``igen`` group).
 
-    The file is written next to ``path`` and moved into place when complete. Returns the demo count.
+    Every demo gets ``next_obs``; ``mask/train`` and ``mask/valid`` split the demos
+    (:func:`split_train_valid`). The file is written next to ``path`` and moved into place when
+    complete. Returns the demo names in ``mask/train`` and in ``mask/valid``.
     """
     import h5py
 
+    check_valid_fraction(valid_fraction)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     partial = path.with_name(path.name + ".partial")
@@ -230,11 +314,12 @@ def write_robomimic(path: Path, spec: TaskSpec, actions: ActionSpace, episodes, 
             total += ep.length
         data.attrs["total"] = total
         data.attrs["env_args"] = json.dumps(env_args)
-        names = np.array([f"demo_{i}" for i in range(len(data))], dtype="S")
-        file.create_group("mask").create_dataset("train", data=names)
-        count = len(data)
+        train, valid = split_train_valid(list(data), valid_fraction, split_seed)
+        masks = file.create_group("mask")
+        masks.create_dataset("train", data=np.array(train, dtype="S"))
+        masks.create_dataset("valid", data=np.array(valid, dtype="S"))
     partial.replace(path)
-    return count
+    return train, valid
 
 
 def _write_demo(group, ep: Episode, spec: TaskSpec, actions: ActionSpace) -> None:
@@ -247,11 +332,17 @@ def _write_demo(group, ep: Episode, spec: TaskSpec, actions: ActionSpace) -> Non
     rewards[-1] = 1.0 if ep.success else 0.0
     group.create_dataset("rewards", data=rewards)
     group.create_dataset("dones", data=(np.arange(n) == n - 1).astype(np.int64))
-    obs = group.create_group("obs")
-    obs.create_dataset("robot0_eef_pos", data=ep.state[:, :3])
-    obs.create_dataset("robot0_eef_quat", data=ep.state[:, 3:7])  # xyzw, as robosuite's observations
-    obs.create_dataset("robot0_gripper_qpos", data=np.stack([width / 2, -width / 2], axis=1))
-    obs.create_dataset("object", data=ep.env_state)
+    observations = {
+        "robot0_eef_pos": ep.state[:, :3],
+        "robot0_eef_quat": ep.state[:, 3:7],  # xyzw, as robosuite's observations
+        "robot0_gripper_qpos": np.stack([width / 2, -width / 2], axis=1),
+        "object": ep.env_state,
+    }
+    obs, next_obs = group.create_group("obs"), group.create_group("next_obs")
+    for key in OBS_KEYS:
+        obs.create_dataset(key, data=observations[key])
+        # the observation after each step: the next step's, the last one repeated (robomimic's convention)
+        next_obs.create_dataset(key, data=np.concatenate([observations[key][1:], observations[key][-1:]]))
     info = group.create_group("datagen_info")
     info.create_dataset("eef_pose", data=eef)
     targets = [actions.target_pose(T, a) for T, a in zip(eef, ep.action, strict=True)]

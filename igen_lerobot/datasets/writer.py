@@ -12,9 +12,7 @@ import functools
 import itertools
 import json
 import logging
-import shlex
 import shutil
-import sys
 import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -22,16 +20,14 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.episode import Episode
 from igen_lerobot.core.exceptions import ConfigError, DatasetSchemaError
 from igen_lerobot.core.task import TaskSpec
+from igen_lerobot.datasets.meta import IGEN_META_FILE, running_command
 from igen_lerobot.datasets.schema import SCHEMA_VERSION, SIM_STATE, dataset_features, episode_frames
 from igen_lerobot.datasets.spool import EpisodeSpool
 
 logger = logging.getLogger(__name__)
-
-IGEN_META_FILE = "meta/igen.json"
 
 
 @contextlib.contextmanager
@@ -99,7 +95,7 @@ def sim_state_stats_skipped() -> contextlib.AbstractContextManager:
 
 @dataclass
 class BuildSummary:
-    """What :meth:`DatasetBuilder.finalize` wrote."""
+    """What :meth:`DatasetBuilder.write` (``root``: the build folder) or ``finalize`` (``root``: the dataset) wrote."""
 
     root: Path
     episodes: int
@@ -137,58 +133,51 @@ class DatasetBuilder:
             self.work_dir.mkdir(parents=True, exist_ok=True)
             marker.write_text(json.dumps({"task": self.spec.name}))
 
-    def finalize(
-        self,
-        num_episodes: int | None,
-        metadata: dict,
-        fast_write: bool = True,
-        cameras: CameraConfig | None = None,
-        render_workers: int = 1,
-    ) -> BuildSummary:
-        """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at ``root``.
+    @property
+    def build_dir(self) -> Path:
+        """Where :meth:`write` builds the dataset (inside the work folder) before it is published."""
+        return self.work_dir / "state_only"  # not "lerobot" or "chunks": igen-render's names in the same folder
 
-        With ``cameras``, the frames are then rendered from their simulator states (``igen-render``'s
-        resumable path, into the same work folder) and the dataset at ``root`` carries the images.
+    def write(self, num_episodes: int | None, metadata: dict, fast_write: bool = True) -> BuildSummary:
+        """Write the first ``num_episodes`` kept attempts as a LeRobot dataset at :attr:`build_dir`.
+
+        Nothing is at ``root`` yet: :meth:`publish` moves it there, or a caller that wants camera
+        streams renders :attr:`build_dir` into ``root`` (``render_dataset(..., overwrite=True)``, which
+        publishes it and removes the work folder).
         """
         start = time.perf_counter()
         kept = self.spool.kept_attempts()
         count = len(kept) if num_episodes is None else min(num_episodes, len(kept))
         if count == 0:
             raise ConfigError(f"no episode was kept in {self.spool.directory}; nothing to write")
-        rendering = cameras is not None and bool(cameras.cameras)
-        build_dir = self.work_dir / ("state_only" if rendering else "lerobot")
         episodes = (episode for _, episode in self.spool.iter_kept(count))
         frames, _ = write_lerobot_dataset(
-            build_dir, self.repo_id, self.spec, episodes, count, metadata, fast_write=fast_write
+            self.build_dir, self.repo_id, self.spec, episodes, count, metadata, fast_write=fast_write
         )
-        if rendering:
-            from igen_lerobot.datasets.render import render_dataset
-
-            # renders into <root>.partial/chunks, publishes <root> and removes the work folder
-            render_dataset(build_dir, self.root, self.repo_id, cameras, num_workers=render_workers, overwrite=True)
-        else:
-            self._publish(build_dir)
         seconds = time.perf_counter() - start
-        logger.info("wrote %d episodes (%d frames) to %s in %.1f s", count, frames, self.root, seconds)
-        return BuildSummary(self.root, count, frames, seconds)
+        logger.info("wrote %d episodes (%d frames) to %s in %.1f s", count, frames, self.build_dir, seconds)
+        return BuildSummary(self.build_dir, count, frames, seconds)
 
-    def _publish(self, build_dir: Path) -> None:
-        """Swap the finished dataset into place; the old one (if overwriting) goes only after."""
+    def publish(self) -> Path:
+        """Swap the dataset :meth:`write` built into place at ``root``; the old one (if overwriting) goes only after."""
         old = None
         if self.root.exists():
             old = self.root.with_name(self.root.name + ".old")
             if old.exists():
                 shutil.rmtree(old)
             self.root.rename(old)
-        build_dir.rename(self.root)
+        self.build_dir.rename(self.root)
         if old is not None:
             shutil.rmtree(old)
         shutil.rmtree(self.work_dir)
+        return self.root
 
-
-def running_command() -> str:
-    """The command line of this process, as a user would type it (recorded with every dataset)."""
-    return shlex.join([Path(sys.argv[0]).name, *sys.argv[1:]])
+    def finalize(self, num_episodes: int | None, metadata: dict, fast_write: bool = True) -> BuildSummary:
+        """:meth:`write`, then :meth:`publish`: the dataset at ``root``, state only."""
+        start = time.perf_counter()
+        built = self.write(num_episodes, metadata, fast_write=fast_write)
+        self.publish()
+        return BuildSummary(self.root, built.episodes, built.frames, time.perf_counter() - start)
 
 
 def write_lerobot_dataset(

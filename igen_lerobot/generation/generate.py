@@ -13,6 +13,7 @@ from igen_lerobot.core.episode import Episode, EpisodeKind
 from igen_lerobot.core.error_models import NoNoise
 from igen_lerobot.core.exceptions import DatasetSchemaError
 from igen_lerobot.datasets.merge import merge_datasets
+from igen_lerobot.datasets.meta import simulation_origin
 from igen_lerobot.datasets.reader import load_episodes
 from igen_lerobot.datasets.writer import DatasetBuilder
 from igen_lerobot.generation.attempt import Attempt
@@ -140,10 +141,11 @@ def generate(cfg: GenerateConfig) -> None:
             f"igen-generate: only {kept}/{cfg.num_episodes} episodes kept within the attempt budget; the spool in "
             f"{builder.work_dir} is kept: re-run with a larger --max_attempts to continue"
         )
-    summary = builder.finalize(
+    built = builder.write(
         cfg.num_episodes,
         metadata={
             "created_by": "igen-generate",
+            "origin": simulation_origin(spec.robot_type, env_cfg.package_name),
             "mode": mode.value,
             "seed": cfg.seed,
             "source": str(source_root),
@@ -157,11 +159,16 @@ def generate(cfg: GenerateConfig) -> None:
                 "dropped": builder.spool.rejection_reasons(),
             },
         },
-        cameras=cfg.render,
-        render_workers=cfg.workers,
     )
-    print(f"Wrote {summary.episodes} {mode.value} episodes ({summary.frames} frames) to {summary.root}")
-    cfg.dataset.publish(summary.root)
+    if cfg.render.cameras:
+        from igen_lerobot.datasets.render import render_dataset
+
+        # renders into <root>.partial/chunks, publishes <root> and removes the work folder
+        render_dataset(built.root, builder.root, builder.repo_id, cfg.render, num_workers=cfg.workers, overwrite=True)
+    else:
+        builder.publish()
+    print(f"Wrote {built.episodes} {mode.value} episodes ({built.frames} frames) to {builder.root}")
+    cfg.dataset.publish(builder.root)
     if cfg.merge_with:
         merged = root.with_name(root.name + "_merged")
         merge_datasets([Path(cfg.merge_with), root], merged, f"{repo_id}_merged", spec, overwrite=cfg.dataset.overwrite)
