@@ -58,7 +58,10 @@ class PandaTaskEnv(TaskEnv):
         home = np.asarray(home_pos, dtype=float)
         self.arm = PandaArm(model, default_qpos, home, control_hz=spec.fps, home_rot=home_rot)
         self.model, self.data = model, self.arm.data
-        self.bodies = {name: self._body(f"{name}_main") for name in spec.objects}
+        # each object's root body: ``<name>_main`` for robosuite's primitives and XML objects, ``<name>_root``
+        # for its composite objects (a ``Bin``)
+        roots = {obj.name: obj.root_body for obj in objects}
+        self.bodies = {name: self._body(roots.get(name, f"{name}_main")) for name in spec.objects}
         self.part_masks = {name: self.arm.geom_mask(self.collision_geoms(body)) for name, body in self.bodies.items()}
         self.part_masks[GRIPPER] = self.arm.gripper_geom_mask
         self._free_qpos = {

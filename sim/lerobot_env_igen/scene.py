@@ -43,7 +43,8 @@ def build_panda_table_scene(objects: list) -> tuple[mujoco.MjModel, np.ndarray]:
 
     Args:
         objects: robosuite ``MujocoObject`` instances, free (default joints) or fixed
-            (``joints=None``); each becomes a body ``<name>_main`` that the task moves at reset.
+            (``joints=None``); each becomes a root body (``<name>_main``, or ``<name>_root`` for a
+            composite object such as a ``Bin``) that the task moves at reset.
 
     Returns:
         The compiled model and robosuite's default Panda joint configuration (7,).
