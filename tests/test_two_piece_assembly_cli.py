@@ -1,0 +1,108 @@
+"""2-Piece Assembly through the commands a user runs, kept small (a few episodes, one worker):
+igen-collect (demos, and human-gated interventions under both reveal modes), igen-generate (all
+three modes, the scripted base policy for IntervenGen), igen-eval of the scripted policy and
+igen-render (agentview + wrist).
+
+The first command runs as a subprocess (the console script itself); the others call the same entry
+points in this process to spare ~15 s of imports each (see tests/test_nut_insertion_cli.py).
+"""
+
+import json
+
+import numpy as np
+import pytest
+from test_nut_insertion_cli import ok, run, run_here
+
+from igen_lerobot.core.episode import EpisodeKind
+from igen_lerobot.core.task import FrameSource
+from igen_lerobot.datasets.reader import dataset_spec, load_episodes
+
+TASK = "--env.type=two_piece_assembly"
+DIRECTION = "--env.reveal=direction"
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    """Sources recorded with igen-collect (scripted operator) and a dataset of each generation mode."""
+    root = tmp_path_factory.mktemp("two_piece")
+    ok(run("igen-collect", TASK, "--mode=demos", "--num_episodes=2", f"--dataset.root={root / 'demos'}"))
+    ok(run_here("igen-collect", TASK, "--mode=interventions", "--num_episodes=2", f"--dataset.root={root / 'int'}"))
+    ok(
+        run_here(
+            "igen-collect",
+            TASK,
+            DIRECTION,
+            "--mode=interventions",
+            "--num_episodes=2",
+            f"--dataset.root={root / 'dir'}",
+        )
+    )
+    for mode, source, flags in (
+        ("mimicgen", "demos", ()),
+        ("igen", "int", ()),
+        ("igen_no_policy", "int", ()),
+        ("igen_direction", "dir", (DIRECTION,)),
+    ):
+        ok(
+            run_here(
+                "igen-generate",
+                f"--mode={mode.removesuffix('_direction')}",
+                TASK,
+                *flags,
+                f"--source.root={root / source}",
+                "--num_episodes=3",
+                "--workers=1",
+                f"--dataset.root={root / mode}",
+            )
+        )
+    return root
+
+
+def test_collect_records_demos_and_interventions_under_both_reveal_modes(data):
+    spec = dataset_spec(data / "demos")
+    assert spec.name == "two_piece_assembly" and spec.objects == ("piece", "receptacle") and len(spec.action_names) == 7
+    assert all(ep.success and ep.kind == EpisodeKind.DEMO for ep in load_episodes(data / "demos", spec))
+    for name in ("int", "dir"):
+        spec = dataset_spec(data / name)
+        for ep in load_episodes(data / name, spec):
+            assert ep.success and ep.kind == EpisodeKind.INTERVENTION
+            takeover = int(np.flatnonzero(ep.is_intervention)[0])
+            # the operator took over at the piece-receptacle contact that revealed, after the policy's frames
+            assert ep.env_state[takeover, spec.env_state_index("revealed")] == 1.0
+            assert np.all(ep.source[:takeover] == FrameSource.POLICY)
+    spec = dataset_spec(data / "dir")
+    hint = [spec.env_state_index(f"receptacle.dir.{a}") for a in "xy"]
+    for ep in load_episodes(data / "dir", spec):
+        takeover = int(np.flatnonzero(ep.is_intervention)[0])
+        assert np.linalg.norm(ep.env_state[takeover, hint]) == pytest.approx(1.0, abs=1e-5)  # a unit vector ...
+        assert not ep.env_state[0, hint].any()  # ... seen only after the contact
+
+
+def test_generate_writes_all_three_modes(data):
+    spec = dataset_spec(data / "demos")
+    for mode, kind in (("mimicgen", EpisodeKind.MIMICGEN), ("igen", EpisodeKind.IGEN)):
+        episodes = load_episodes(data / mode, spec)
+        assert len(episodes) == 3 and all(ep.kind == kind and ep.success for ep in episodes)
+    for ep in load_episodes(data / "igen", spec):
+        assert ep.is_intervention[0] and ep.env_state[0, spec.env_state_index("revealed")] == 1.0
+    for ep in load_episodes(data / "igen_no_policy", spec):
+        assert ep.kind == EpisodeKind.IGEN_NO_POLICY and not (ep.source == FrameSource.POLICY).any()
+    meta = json.loads((data / "igen_direction" / "meta" / "igen.json").read_text())
+    assert meta["task"] == "two_piece_assembly" and meta["reveal"] == "direction"
+    assert len(load_episodes(data / "igen_direction", dataset_spec(data / "igen_direction"))) == 3
+
+
+def test_eval_of_the_scripted_policy_and_render_of_both_cameras(data, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    report = tmp_path / "eval.json"
+    ok(run_here("igen-eval", TASK, "--n_trials=2", f"--output={report}"))
+    result = json.loads(report.read_text())
+    assert result["task"] == "two_piece_assembly" and result["best"]["trials"] == 2
+    assert result["corruption"]["type"] == "box" and result["corruption"]["min_abs"] == [0.01, 0.01, 0.01]
+    out = tmp_path / "rgb"
+    ok(run_here("igen-render", f"--dataset.root={data / 'demos'}", "--cameras=[agentview,wrist]", "--size=32",
+                f"--output.root={out}"))  # fmt: skip
+    rendered = LeRobotDataset("local/rgb", root=out)
+    assert {"observation.images.agentview", "observation.images.wrist"} <= set(rendered.meta.features)
+    assert rendered.meta.total_frames == LeRobotDataset("local/d", root=data / "demos").meta.total_frames
