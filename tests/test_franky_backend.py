@@ -33,8 +33,11 @@ def world_from_base():
     return T
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def empty_sim():
+    """A franky-sim of its own for each test: on a slower host an arm left moving or faulted by the
+    previous test made the next test's first move home fail to plan (ruckig -101/-110, 3 of 15 tests
+    failing in a row); a server costs ~1.5 s."""
     with franky_sim(cube=None) as server:
         yield server.host
 
