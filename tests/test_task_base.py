@@ -149,7 +149,6 @@ def test_the_scripted_operator_takes_over_when_its_takeover_rule_says_so():
 
 
 def test_the_shipped_tasks_build_their_takeover_from_their_geometry():
-    pytest.importorskip("mujoco")
     from lerobot_env_igen.block_grasp.scripted import ScriptedGraspOperator
     from lerobot_env_igen.nut_insertion.config import NutInsertionEnvConfig
 
