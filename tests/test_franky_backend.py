@@ -64,13 +64,32 @@ def test_state_frames_and_home(empty_sim):
         arm.disconnect()
 
 
+def robot_seconds(arm: FrankyArm) -> float:
+    """The arm's own clock (libfranka's robot time) [s]."""
+    return arm.robot.state.time.to_sec()
+
+
+def wait_on_robot_clock(arm: FrankyArm, since: float, period: float, deadline: float = 2.0) -> None:
+    """Sleep until the arm's clock has run ``period`` past ``since`` (at most ``deadline`` s of wall time).
+
+    A real arm's clock is the wall clock. franky-sim's is not: its 1 kHz loop is Python, and on this
+    VM it ran at 0.5-0.9 of wall time, lower when the host steals CPU (vmstat: 14-50% steal during
+    failing runs). A loop paced on the wall clock then streams faster than 20 Hz as the arm sees it.
+    """
+    wall_end = time.perf_counter() + deadline
+    while robot_seconds(arm) - since < period and time.perf_counter() < wall_end:
+        time.sleep(0.001)
+
+
 def test_a_20hz_stream_of_absolute_targets_is_followed(empty_sim):
     """A scripted target that moves 6 cm at 6 cm/s, then holds, out and back: what the trajectory
     controller promises (module docstring of franky_arm). Measured on this machine over 90 legs, idle
     and beside busy loops (benchmarks/bench_franky_settling.py, docs/benchmarks.md): within 5 mm when
-    the goal stops, at most 3.1 mm past it, within 0.1 mm one second later. franky-sim runs slower
-    than real time here (0.7-0.9), so the hold is a deadline, not a fixed wait.
-    Tolerances: within 5 mm for 5 periods running before 3 s of holding; under 1 cm past the goal."""
+    the goal stops, at most 3.1 mm past it, within 0.1 mm one second later. The stream is paced on
+    the arm's clock (20 Hz as the arm sees it, see wait_on_robot_clock): paced on the wall clock it
+    went 16-27 mm past the goal or rang around it whenever franky-sim's clock fell to about half speed.
+    Tolerances: within 5 mm for 5 periods running before 3 s (arm's clock) of holding; under 1 cm
+    past the goal; 18 Hz or more on the arm's clock."""
     arm = connected(empty_sim)
     safe = SafeArm(arm, world_from_base(), SafetyLimits())
     try:
@@ -79,12 +98,12 @@ def test_a_20hz_stream_of_absolute_targets_is_followed(empty_sim):
         calls, ticks = [], []
 
         def stream(goal: np.ndarray) -> np.ndarray:
-            ticks.append(time.perf_counter())
+            ticks.append(robot_seconds(arm))
             _, T = safe.read()
             start = time.perf_counter()
             safe.command(T, goal - T[:3, 3], close_gripper=False, period=0.05)
             calls.append(time.perf_counter() - start)
-            time.sleep(max(0.0, 0.05 - (time.perf_counter() - ticks[-1])))
+            wait_on_robot_clock(arm, ticks[-1], 0.05)
             return T[:3, 3]
 
         origin = T_start[:3, 3].copy()
@@ -103,7 +122,7 @@ def test_a_20hz_stream_of_absolute_targets_is_followed(empty_sim):
             assert within == 5, f"did not settle within 5 mm of {goal} in 3 s: {hand}"
             assert past < 0.01, f"{past * 1000:.1f} mm past {goal}"
         rate = (len(ticks) - 1) / (ticks[-1] - ticks[0])
-        assert rate > 18.0, rate  # 20 Hz asked; tolerance for a busy 2-core machine
+        assert rate > 18.0, rate  # 20 Hz asked, on the arm's clock
         assert np.median(calls) < 0.005  # an asynchronous move returns at once
         assert safe.fault is None
     finally:
@@ -422,7 +441,10 @@ def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(e
         arm.send_target(T)
         time.sleep(2.0)
         assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.05
-        arm.config = replace(arm.config, home_position=(float("nan"), 0.0, 0.2))  # no Cartesian plan exists
+        # no Cartesian plan exists. The deadline is the fallback's, not what this test is about: the
+        # joint-space move home at 5% acceleration and jerk ran past the 30 s default in CI, when
+        # franky-sim's clock had fallen to about half of wall time
+        arm.config = replace(arm.config, home_position=(float("nan"), 0.0, 0.2), home_timeout=120.0)
         arm.move_home()
         np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)  # tolerance 5 mm
     finally:

@@ -113,6 +113,14 @@ def record_dataset(root: Path, repo_id: str) -> list[np.ndarray]:
     return path
 
 
+def path_deviation(points: np.ndarray, path: np.ndarray) -> np.ndarray:
+    """Each point's distance to the polyline ``path``."""
+    starts, seg = path[:-1], np.diff(path, axis=0)
+    t = np.einsum("psk,sk->ps", points[:, None] - starts[None], seg) / np.maximum((seg**2).sum(axis=1), 1e-12)
+    nearest = starts[None] + np.clip(t, 0.0, 1.0)[..., None] * seg[None]
+    return np.linalg.norm(points[:, None] - nearest, axis=2).min(axis=1)
+
+
 def replay_command(root: Path, repo_id: str, trace: Path, *arm: str) -> list[str]:
     """lerobot-replay of episode 0 on igen_franka with the given ``--robot.arm.*`` arguments."""
     return [
@@ -302,8 +310,17 @@ def test_lerobot_replay_drives_franky_sim_through_the_franky_backend(square_data
     recorded = LeRobotDataset(repo_id, root=root, episodes=[0])
     actions = np.stack([recorded[i]["action"].numpy() for i in range(len(lines))])
     measured = np.array([line["measured"] for line in lines])
-    # the FR3 follows the square in the task frame. Tolerance 3 cm: "measured" is read right after
-    # the target is sent, and the jerk-limited arm (acceleration/jerk at 5%) trails a target moving at 10 cm/s
+    # the FR3 follows the square in the task frame (a wrong frame or axis sends it elsewhere). When it
+    # is measured along the way is franky-sim's business: LeRobot's loop keeps 20 Hz of wall time, and
+    # franky-sim's clock ran at 0.5-0.9 of it on this VM (lower when the host steals CPU), so the
+    # jerk-limited arm (acceleration/jerk at 5%) trailed the target by 2-5 cm. What is compared is the
+    # path: each reading's distance to the square the actions trace, and how far along it the hand got.
     assert len(lines) == 60
-    error = np.linalg.norm(measured[5:] - actions[5:, :3], axis=1)
-    assert error.max() < 0.03 and error.mean() < 0.02, error
+    # Tolerances: 1.5 cm off the path at most (measured idle: 4.2 mm), and the hand passed within 1 cm
+    # of the middle of each of the first three sides (a frozen or mirrored arm does not; a lagging one
+    # does unless it trails by more than a side and a half, 11 cm).
+    off_path = path_deviation(measured[5:], actions[:, :3])
+    assert off_path.max() < 0.015, off_path
+    side_middles = actions[[7, 22, 37], :3]
+    closest = np.linalg.norm(measured[:, None] - side_middles[None], axis=2).min(axis=0)
+    assert (closest < 0.01).all(), closest
