@@ -6,6 +6,7 @@
 # human-gated interventions per task, recorded here by the scripted operator.
 #
 #   MUJOCO_GL=egl bash benchmarks/bench_tasks.sh [output folder]      # ~30 min on 2 cores; idle machine
+#   IGEN_BENCH_TASKS="coffee" MUJOCO_GL=egl bash benchmarks/bench_tasks.sh   # only the tasks named
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 out=${1:-outputs/bench_tasks}
