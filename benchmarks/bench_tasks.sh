@@ -6,10 +6,11 @@
 # human-gated interventions per task, recorded here by the scripted operator.
 #
 #   MUJOCO_GL=egl bash benchmarks/bench_tasks.sh [output folder]      # ~30 min on 2 cores; idle machine
+#   IGEN_BENCH_TASKS="coffee" MUJOCO_GL=egl bash benchmarks/bench_tasks.sh   # only the tasks named
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 out=${1:-outputs/bench_tasks}
-tasks=(block_grasp nut_insertion two_piece_assembly)
+tasks=(${IGEN_BENCH_TASKS:-block_grasp nut_insertion two_piece_assembly coffee})
 bin=.venv/bin
 mkdir -p "$out"
 for task in "${tasks[@]}"; do

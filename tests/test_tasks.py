@@ -22,7 +22,7 @@ TASKS = sorted(known_tasks())
 
 
 def test_the_shipped_tasks_and_the_fake_one_are_registered():
-    assert {"block_grasp", "nut_insertion", "two_piece_assembly", "fake_pick_place"} <= set(TASKS)
+    assert {"block_grasp", "nut_insertion", "two_piece_assembly", "coffee", "fake_pick_place"} <= set(TASKS)
 
 
 @pytest.fixture(params=TASKS)

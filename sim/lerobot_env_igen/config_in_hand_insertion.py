@@ -1,4 +1,4 @@
-"""The config of the in-hand insertion family (Nut Insertion, 2-Piece Assembly; Coffee to come).
+"""The config of the in-hand insertion family (Nut Insertion, 2-Piece Assembly, Coffee).
 
 A task of the family declares its :class:`~lerobot_env_igen.in_hand_insertion_spec.InsertionGeometry`
 (``geometry``) and gets 6-DOF actions, the scripted operator (the shared insertion rule on the true

@@ -1,0 +1,87 @@
+"""Coffee through the commands a user runs, kept small (two episodes each, one worker): igen-collect
+(demos and human-gated interventions), igen-generate (all three modes, the scripted base policy for
+IntervenGen), igen-eval of the scripted policy and igen-render (agentview + wrist).
+
+Every command calls its console entry point in this process (same arguments, same code) to spare
+~15 s of imports each; tests/test_nut_insertion_cli.py and tests/test_two_piece_assembly_cli.py run
+the console scripts themselves as subprocesses.
+"""
+
+import json
+
+import numpy as np
+import pytest
+from test_nut_insertion_cli import ok, run_here
+
+from igen_lerobot.core.episode import EpisodeKind
+from igen_lerobot.core.task import FrameSource
+from igen_lerobot.datasets.reader import dataset_spec, load_episodes
+
+TASK = "--env.type=coffee"
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    """Sources recorded with igen-collect (scripted operator) and a dataset of each generation mode."""
+    root = tmp_path_factory.mktemp("coffee")
+    ok(run_here("igen-collect", TASK, "--mode=demos", "--num_episodes=2", f"--dataset.root={root / 'demos'}"))
+    ok(run_here("igen-collect", TASK, "--mode=interventions", "--num_episodes=2", f"--dataset.root={root / 'int'}"))
+    for mode, source in (("mimicgen", "demos"), ("igen", "int"), ("igen_no_policy", "int")):
+        ok(
+            run_here(
+                "igen-generate",
+                f"--mode={mode}",
+                TASK,
+                f"--source.root={root / source}",
+                "--num_episodes=2",
+                "--workers=1",
+                f"--dataset.root={root / mode}",
+            )
+        )
+    return root
+
+
+def test_collect_records_demos_and_interventions(data):
+    spec = dataset_spec(data / "demos")
+    assert spec.name == "coffee" and spec.objects == ("pod", "machine") and len(spec.action_names) == 7
+    assert spec.corruption_names == ("machine.dx", "machine.dy", "machine.dz")
+    assert all(ep.success and ep.kind == EpisodeKind.DEMO for ep in load_episodes(data / "demos", spec))
+    for ep in load_episodes(data / "int", spec):
+        assert ep.success and ep.kind == EpisodeKind.INTERVENTION
+        takeover = int(np.flatnonzero(ep.is_intervention)[0])
+        # the operator took over at the pod-machine contact that revealed, after the policy's frames
+        assert ep.env_state[takeover, spec.env_state_index("revealed")] == 1.0
+        assert np.all(ep.source[:takeover] == FrameSource.POLICY)
+
+
+def test_generate_writes_all_three_modes(data):
+    spec = dataset_spec(data / "demos")
+    for mode, kind in (
+        ("mimicgen", EpisodeKind.MIMICGEN),
+        ("igen", EpisodeKind.IGEN),
+        ("igen_no_policy", EpisodeKind.IGEN_NO_POLICY),
+    ):
+        episodes = load_episodes(data / mode, spec)
+        assert len(episodes) == 2 and all(ep.kind == kind and ep.success for ep in episodes)
+    for ep in load_episodes(data / "igen", spec):
+        assert ep.is_intervention[0] and ep.env_state[0, spec.env_state_index("revealed")] == 1.0
+    for ep in load_episodes(data / "igen_no_policy", spec):
+        assert not (ep.source == FrameSource.POLICY).any()
+    meta = json.loads((data / "igen" / "meta" / "igen.json").read_text())
+    assert meta["task"] == "coffee" and meta["reveal"] == "full"
+
+
+def test_eval_of_the_scripted_policy_and_render_of_both_cameras(data, tmp_path):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    report = tmp_path / "eval.json"
+    ok(run_here("igen-eval", TASK, "--n_trials=2", f"--output={report}"))
+    result = json.loads(report.read_text())
+    assert result["task"] == "coffee" and result["best"]["trials"] == 2
+    assert result["corruption"] == {**result["corruption"], "type": "radial", "r_min": 0.02, "r_max": 0.04}
+    out = tmp_path / "rgb"
+    ok(run_here("igen-render", f"--dataset.root={data / 'demos'}", "--cameras=[agentview,wrist]", "--size=32",
+                f"--output.root={out}"))  # fmt: skip
+    rendered = LeRobotDataset("local/rgb", root=out)
+    assert {"observation.images.agentview", "observation.images.wrist"} <= set(rendered.meta.features)
+    assert rendered.meta.total_frames == LeRobotDataset("local/d", root=data / "demos").meta.total_frames
