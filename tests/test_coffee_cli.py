@@ -85,3 +85,30 @@ def test_eval_of_the_scripted_policy_and_render_of_both_cameras(data, tmp_path):
     rendered = LeRobotDataset("local/rgb", root=out)
     assert {"observation.images.agentview", "observation.images.wrist"} <= set(rendered.meta.features)
     assert rendered.meta.total_frames == LeRobotDataset("local/d", root=data / "demos").meta.total_frames
+
+
+def test_viz_and_the_recovery_picture_show_the_believed_and_true_machine(data, tmp_path):
+    """igen-viz draws the machine where it was believed and where it was; the README's recovery
+    picture (scripts/recovery_picture.sh) puts the believed machine at the true one plus the episode's
+    error, since a generated recovery starts already revealed (exact: the same numbers added)."""
+    from test_viz import column, read_rrd
+
+    from igen_lerobot.viz.picture import believed_position, draw_episode
+
+    ok(run_here("igen-viz", f"--dataset.root={data / 'igen'}", "--episodes=[0]", f"--output={tmp_path / 'out.rrd'}"))
+    chunks = read_rrd(tmp_path / "out.rrd")
+    for which in ("true", "believed"):
+        half = column(chunks[f"/episodes/0/machine/{which}"], "Boxes3D:half_sizes")
+        np.testing.assert_allclose(np.array(half[0][0]), [0.067, 0.045, 0.045], atol=1e-6)
+    spec = dataset_spec(data / "igen")
+    (episode,) = load_episodes(data / "igen", spec, episodes=[0])
+    k = spec.objects.index("machine")
+    revealed = spec.revealed_flags(episode.env_state)
+    assert revealed[0]
+    true = episode.true_object_pose[0, 7 * k : 7 * k + 3]
+    believed = believed_position(episode, k, revealed)
+    np.testing.assert_array_equal(believed, true + episode.corruption)
+    assert 0.02 - 1e-9 <= np.linalg.norm(believed[:2] - true[:2]) <= 0.04 + 1e-9  # the radial error
+    picture = tmp_path / "recovery.png"
+    draw_episode(episode, spec, picture, "coffee")
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and picture.stat().st_size > 10_000

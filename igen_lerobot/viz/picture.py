@@ -18,6 +18,17 @@ import numpy as np
 from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_phases
 
 
+def believed_position(episode, k: int, revealed_flags: np.ndarray) -> np.ndarray:
+    """Where the robot believed object ``k`` was before the reveal.
+
+    The first frame's observed pose, unless the episode starts already revealed (a generated
+    recovery starts at the contact): then the true position plus the episode's position error.
+    """
+    if not revealed_flags[0] or len(episode.corruption) != 3:
+        return episode.env_state[0, 7 * k : 7 * k + 3]
+    return episode.true_object_pose[0, 7 * k : 7 * k + 3] + np.asarray(episode.corruption, float)
+
+
 def draw_episode(episode, spec, output: Path, title: str) -> None:
     """Render ``episode`` (an :class:`~igen_lerobot.core.episode.Episode` of task ``spec``) to a PNG."""
     import matplotlib
@@ -33,14 +44,14 @@ def draw_episode(episode, spec, output: Path, title: str) -> None:
     fig, (top, side) = plt.subplots(1, 2, figsize=(11, 4.6), gridspec_kw={"width_ratios": [1, 1.4]})
     k = spec.objects.index(spec.corrupted_object)
     true = episode.true_object_pose[0, 7 * k : 7 * k + 3]
-    believed = episode.env_state[0, 7 * k : 7 * k + 3]  # where the robot believed it until the reveal
-    half = spec.box(spec.corrupted_object).half_size[0]
+    believed = believed_position(episode, k, revealed_flags)
     obj = spec.corrupted_object
+    box = spec.box(obj)
+    half, offset = np.asarray(box.half_size[:2]), np.asarray(box.center[:2])  # the object does not turn here
     boxes = ((believed, "#db4437", "--", f"believed {obj}"), (true, "#0f9d58", "-", f"true {obj}"))
     for centre, color, style, label in boxes:
-        top.add_patch(
-            Rectangle(centre[:2] - half, 2 * half, 2 * half, fill=False, ec=color, ls=style, lw=2, label=label)
-        )
+        corner = centre[:2] + offset - half
+        top.add_patch(Rectangle(corner, *(2 * half), fill=False, ec=color, ls=style, lw=2, label=label))
     top.scatter(eef[:, 0], eef[:, 1], c=colors, s=10, zorder=3)
     top.plot(eef[:, 0], eef[:, 1], color="#999999", lw=0.5, zorder=2)
     top.set_xlabel("x [m]")
