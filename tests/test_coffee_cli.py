@@ -1,6 +1,7 @@
 """Coffee through the commands a user runs, kept small (two episodes each, one worker): igen-collect
 (demos and human-gated interventions), igen-generate (all three modes, the scripted base policy for
-IntervenGen), igen-eval of the scripted policy and igen-render (agentview + wrist).
+IntervenGen), igen-eval of the scripted policy, igen-render (agentview + wrist), igen-viz and the
+recovery picture, and LeRobot's lerobot-train + lerobot-eval on the task's env plugin.
 
 Every command calls its console entry point in this process (same arguments, same code) to spare
 ~15 s of imports each; tests/test_nut_insertion_cli.py and tests/test_two_piece_assembly_cli.py run
@@ -112,3 +113,21 @@ def test_viz_and_the_recovery_picture_show_the_believed_and_true_machine(data, t
     picture = tmp_path / "recovery.png"
     draw_episode(episode, spec, picture, "coffee")
     assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and picture.stat().st_size > 10_000
+
+
+def lerobot_train_and_eval(dataset, task: str, tmp_path) -> dict:
+    """LeRobot's own lerobot-train (2 BC-RNN steps: plumbing, not quality) on ``dataset``, then
+    lerobot-eval of the checkpoint on ``task``'s env plugin for one short episode; its eval_info."""
+    ok(run_here("lerobot-train", "--policy.type=bc_rnn", "--dataset.repo_id=local/mimicgen",
+                f"--dataset.root={dataset}", "--steps=2", "--batch_size=4", "--policy.device=cpu",
+                f"--output_dir={tmp_path / 'train'}", "--policy.push_to_hub=false", "--save_freq=2", "--num_workers=0",
+                "--wandb.enable=false"))  # fmt: skip
+    checkpoint = tmp_path / "train/checkpoints/last/pretrained_model"
+    ok(run_here("lerobot-eval", f"--policy.path={checkpoint}", task, "--env.episode_length=10", "--eval.n_episodes=1",
+                "--eval.batch_size=1", "--policy.device=cpu", f"--output_dir={tmp_path / 'eval'}"))  # fmt: skip
+    return json.loads((tmp_path / "eval/eval_info.json").read_text())
+
+
+def test_lerobot_train_and_lerobot_eval_run_on_the_task(data, tmp_path):
+    info = lerobot_train_and_eval(data / "mimicgen", TASK, tmp_path)
+    assert info["overall"]["n_episodes"] == 1

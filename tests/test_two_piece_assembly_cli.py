@@ -1,7 +1,7 @@
 """2-Piece Assembly through the commands a user runs, kept small (a few episodes, one worker):
 igen-collect (demos, and human-gated interventions under both reveal modes), igen-generate (all
 three modes, the scripted base policy for IntervenGen), igen-eval of the scripted policy and
-igen-render (agentview + wrist).
+igen-render (agentview + wrist), and LeRobot's lerobot-train + lerobot-eval on the task's env plugin.
 
 The first command runs as a subprocess (the console script itself); the others call the same entry
 points in this process to spare ~15 s of imports each (see tests/test_nut_insertion_cli.py).
@@ -106,3 +106,10 @@ def test_eval_of_the_scripted_policy_and_render_of_both_cameras(data, tmp_path):
     rendered = LeRobotDataset("local/rgb", root=out)
     assert {"observation.images.agentview", "observation.images.wrist"} <= set(rendered.meta.features)
     assert rendered.meta.total_frames == LeRobotDataset("local/d", root=data / "demos").meta.total_frames
+
+
+def test_lerobot_train_and_lerobot_eval_run_on_the_task(data, tmp_path):
+    from test_coffee_cli import lerobot_train_and_eval
+
+    info = lerobot_train_and_eval(data / "mimicgen", TASK, tmp_path)
+    assert info["overall"]["n_episodes"] == 1
