@@ -179,3 +179,48 @@ def test_table_config_refuses_seeds_that_break_the_protocol():
         TableConfig(train_seeds=[1, 1])
     with pytest.raises(ConfigError, match="--val_seed and --test_seed must differ"):
         TableConfig(val_seed=3, test_seed=3)
+
+
+def test_the_data_scaling_table_is_a_named_table_with_sized_rows(tmp_path):
+    """2-Piece Assembly's --table=scaling: I-Gen with 200/1000/5000 generated interventions against 100
+    operator interventions, each its own dataset made by its unsized row's command with n episodes
+    (same seed: the 100 operator interventions begin with the 10 sources), merged with D alike."""
+    from igen_lerobot.core.exceptions import ConfigError
+    from igen_lerobot.experiments.table_steps import needed_parts, variant_label, variant_part
+
+    cfg = TableConfig(task="two_piece_assembly", table="scaling", output_dir=str(tmp_path / "t"))
+    assert cfg.variants == ["source_int_100", "igen_200", "igen_1000", "igen_5000"]
+    assert cfg.name == "two_piece_assembly_scaling"
+    assert cfg.paper_table().success == {"source_int_100": 46, "igen_200": 34, "igen_1000": 70, "igen_5000": 88}
+    labels = ["Source Int (100)", "I-Gen (200)", "I-Gen (1000)", "I-Gen (5000)"]
+    assert [variant_label(v) for v in cfg.variants] == labels
+    assert all(variant_part(v) == v for v in cfg.variants)
+    steps = {step.name: step for step in needed_parts(cfg.variants)}
+    assert set(steps) == {"source_int", *cfg.variants}  # the generators' source is built too
+    data = lambda name: tmp_path / name  # noqa: E731
+    command = steps["igen_5000"].command(cfg, data, ["--env.type=two_piece_assembly"], policy="P")
+    assert "--num_episodes=5000" in command and f"--source.root={tmp_path / 'source_int'}" in command
+    assert "--mode=igen" in command and "--policy.path=P" in command
+    assert steps["source_int_100"].command(cfg, data, [], policy="P")[:1] == ["--mode=interventions"]
+    assert steps["source_int_100"].seed_offset == steps["source_int"].seed_offset
+    assert "--num_episodes=100" in steps["source_int_100"].command(cfg, data, [], policy="P")
+    # the main table is unchanged, and a wrong name or row says what exists
+    assert TableConfig(task="two_piece_assembly").variants == list(VARIANTS)
+    with pytest.raises(ConfigError, match=r"--table='scale'.*\['scaling'\]"):
+        TableConfig(task="two_piece_assembly", table="scale")
+    with pytest.raises(ConfigError, match="sized rows igen_<n>"):
+        TableConfig(task="two_piece_assembly", variants=["igen_0"])
+    with pytest.raises(ConfigError, match="--table=scaling is measured with --reveal=full"):
+        TableConfig(task="two_piece_assembly", table="scaling", reveal="direction")
+
+
+def test_a_table_recorded_before_a_setting_existed_resumes_with_its_default(tmp_path):
+    """A table_config.json written before --table existed has no such key: it is the default, not a change."""
+    from igen_lerobot.experiments.table import check_resumed_config
+
+    out = tmp_path / "t"
+    check_resumed_config(TableConfig(output_dir=str(out), variants=["base"]))
+    recorded = json.loads((out / "table_config.json").read_text())
+    del recorded["table"]
+    (out / "table_config.json").write_text(json.dumps(recorded))
+    check_resumed_config(TableConfig(output_dir=str(out), variants=["base"]))

@@ -130,9 +130,11 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
             "max_episode_steps": self.episode_length,
         }
 
-    def paper_table(self) -> PaperTable | None:
-        """The paper's table for this reveal mode, if the paper has one."""
-        return next((t for t in self.paper_tables if t.reveal is self.reveal), None)
+    def paper_table(self, name: str = "") -> PaperTable | None:
+        """The paper's table for this reveal mode (or the one called ``name``), if the paper has one."""
+        if name:
+            return next((t for t in self.paper_tables if t.name == name), None)
+        return next((t for t in self.paper_tables if t.reveal is self.reveal and not t.name), None)
 
     @abc.abstractmethod
     def make_action_space(self) -> ActionSpace:

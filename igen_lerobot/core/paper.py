@@ -6,15 +6,30 @@ own table with it and shared modules hold no per-task copies.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from igen_lerobot.core.belief import Reveal
 
-__all__ = ["PaperTable", "VARIANTS"]
+__all__ = ["PaperTable", "VARIANTS", "is_variant", "sized_variant"]
 
 # Every dataset variant igen-table knows, in the paper's order (rows of its tables).
 VARIANTS = ("base", "source_int", "weighted_src_int", "source_demo", "mg_demo", "igen_no_policy", "igen")
+# A data-scaling row: ``igen_<n>`` (I-Gen with n generated interventions from the same sources) or
+# ``source_int_<n>`` (n operator interventions), each added to the base data as its unsized row is.
+SIZED_VARIANT = re.compile(r"^(igen|source_int)_([1-9][0-9]*)$")
+
+
+def sized_variant(name: str) -> tuple[str, int] | None:
+    """``("igen", 200)`` for ``igen_200``; None for a name that is not a sized variant."""
+    match = SIZED_VARIANT.match(name)
+    return (match.group(1), int(match.group(2))) if match else None
+
+
+def is_variant(name: str) -> bool:
+    """A row igen-table can build: one of VARIANTS or a sized ``igen_<n>`` / ``source_int_<n>``."""
+    return name in VARIANTS or sized_variant(name) is not None
 
 
 @dataclass(frozen=True)
@@ -25,11 +40,14 @@ class PaperTable:
     rows: tuple[str, ...]  # the variants igen-table runs for it, in order
     success: Mapping[str, int] = field(default_factory=dict)  # the paper's numbers, for the rows it reports
     caption: str = ""  # where in the paper
+    name: str = ""  # igen-table --table=<name> picks it; "" is the table of its reveal mode
 
     def __post_init__(self) -> None:
-        unknown = [r for r in (*self.rows, *self.success) if r not in VARIANTS]
+        unknown = [r for r in (*self.rows, *self.success) if not is_variant(r)]
         if unknown:
-            raise ValueError(f"paper table rows {unknown} are not igen-table variants {VARIANTS}")
+            raise ValueError(
+                f"paper table rows {unknown} are not igen-table variants {VARIANTS} or igen_<n> / source_int_<n>"
+            )
         missing = [r for r in self.success if r not in self.rows]
         if missing:
             raise ValueError(f"paper numbers for {missing}, which are not among the table's rows {self.rows}")

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.env_config import TaskEnvConfig, task_config_class
 from igen_lerobot.core.exceptions import ConfigError
-from igen_lerobot.core.paper import VARIANTS
+from igen_lerobot.core.paper import VARIANTS, PaperTable, is_variant
 from igen_lerobot.evaluation.config_eval import EVAL_SEED
 from igen_lerobot.training.config_train import TrainConfig
 
@@ -20,7 +20,10 @@ class TableConfig:
     """Sizes follow the paper (10 source episodes, 1000 generated, 50 trials); shrink them for a smoke run.
 
     ``--reveal`` picks the observability (default: the task's own, the paper's main table); the
-    rows default to the paper's rows for that table.
+    rows default to the paper's rows for that table. ``--table`` picks another of the task's paper
+    tables by name (2-Piece Assembly: ``scaling``, I-Gen with 200/1000/5000 generated interventions
+    against 100 operator interventions); sized rows ``igen_<n>`` / ``source_int_<n>`` can also be
+    asked for with ``--variants``.
 
     Every row is trained once per seed of ``train_seeds``; each run's checkpoint is chosen on
     ``n_val_trials`` validation trials and reported on ``n_trials`` test trials that no choice
@@ -30,6 +33,7 @@ class TableConfig:
 
     task: str = "block_grasp"
     reveal: str | None = None  # e.g. contact_position for the paper's partial-observability table
+    table: str = ""  # a named paper table of the task (e.g. scaling); "" is the table of the reveal mode
     variants: list[str] | None = None  # default: the rows of the paper's table for this task and reveal mode
     source_episodes: int = 10  # human (here: scripted-operator) episodes of each kind
     base_demos: int = 1000  # MimicGen demonstrations forming the base dataset D
@@ -52,13 +56,15 @@ class TableConfig:
     in_process: bool = False
 
     def __post_init__(self) -> None:
-        env = self.env_config()
+        table = self.paper_table()  # checks --reveal and --table
         if self.variants is None:
-            table = env.paper_table()
             self.variants = list(table.rows) if table is not None else list(VARIANTS)
-        unknown = [v for v in self.variants if v not in VARIANTS]
+        unknown = [v for v in self.variants if not is_variant(v)]
         if unknown or not self.variants:
-            raise ConfigError(f"--variants must be a non-empty subset of {list(VARIANTS)}, got {self.variants}")
+            raise ConfigError(
+                f"--variants must be a non-empty list of {list(VARIANTS)} or sized rows igen_<n> / source_int_<n>, "
+                f"got {self.variants}"
+            )
         if self.train_seeds is None:
             self.train_seeds = [self.train.seed + i for i in range(3)]
         if not self.train_seeds or len(set(self.train_seeds)) != len(self.train_seeds):
@@ -86,9 +92,23 @@ class TableConfig:
             raise ConfigError(f"--reveal={self.reveal!r} is not a reveal mode; use one of {modes}") from None
         return cls(reveal=reveal)
 
+    def paper_table(self) -> PaperTable | None:
+        """The paper's table this run reproduces (checked: a clear error for an unknown --table)."""
+        env = self.env_config()
+        if not self.table:
+            return env.paper_table()
+        table = env.paper_table(self.table)
+        if table is None:
+            names = [t.name for t in env.paper_tables if t.name]
+            raise ConfigError(f"--table={self.table!r}: {self.task} has no table of that name; its tables: {names}")
+        if table.reveal is not env.reveal:
+            raise ConfigError(f"--table={self.table} is measured with --reveal={table.reveal.value}; add that flag")
+        return table
+
     @property
     def name(self) -> str:
         """The table's name in the results folder: the task, and the reveal mode unless it is the task's default."""
         default = task_config_class(self.task)().reveal
         reveal = self.env_config().reveal
-        return self.task if reveal is default else f"{self.task}_{reveal.value}"
+        name = self.task if reveal is default else f"{self.task}_{reveal.value}"
+        return f"{name}_{self.table}" if self.table else name

@@ -24,7 +24,7 @@ import shlex
 import subprocess
 import sys
 import time
-from dataclasses import asdict, replace
+from dataclasses import MISSING, asdict, fields, replace
 from importlib.metadata import entry_points
 from pathlib import Path
 
@@ -36,11 +36,11 @@ from igen_lerobot.experiments.provenance import code_version
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import (
     BASE_STEPS,
-    LABELS,
-    VARIANT_PART,
     VARIANT_WEIGHTS,
     DataStep,
     needed_parts,
+    variant_label,
+    variant_part,
 )
 from igen_lerobot.training.lerobot_train import final_checkpoint, run_command, step_checkpoint, train_command
 
@@ -157,6 +157,8 @@ def check_resumed_config(cfg: TableConfig) -> None:
         recorded_file.write_text(json.dumps(now, indent=2))
         return
     recorded = json.loads(recorded_file.read_text())
+    defaults = {f.name: f.default for f in fields(TableConfig) if f.default is not MISSING}  # keys added since
+    recorded = {**defaults, **recorded}
     changed = sorted(k for k in now if k not in RESUMABLE_CHANGES and recorded.get(k) != now[k])
     if recorded.get("train_seeds") and now["train_seeds"][0] != recorded["train_seeds"][0]:
         changed.append("train_seeds (the first seed trains the policy the data were made with)")
@@ -188,7 +190,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
 
     datasets = {"base": run.data("base")}
     for variant in cfg.variants:
-        part = VARIANT_PART[variant]
+        part = variant_part(variant)
         if part is None:
             continue
         merged = run.data(f"train_{variant}")
@@ -286,7 +288,7 @@ def summarise_row(variant: str, seeds: list[dict], paper: int | None, dataset: d
     successes, trials = sum(s["test"]["successes"] for s in seeds), sum(s["test"]["trials"] for s in seeds)
     return {
         "variant": variant,
-        "label": LABELS[variant],
+        "label": variant_label(variant),
         "success_rate": mean,
         "std": std,
         "min": min(rates),
@@ -311,7 +313,7 @@ def run_table(cfg: TableConfig) -> dict:
     run = TableRun(cfg)
     start = time.perf_counter()
     env = cfg.env_config()
-    paper = env.paper_table()
+    paper = cfg.paper_table()
     datasets = build_datasets(run)
     rows = []
     for variant in cfg.variants:

@@ -53,7 +53,8 @@ def _title(result: dict) -> str:
         "contact_position": "partial observability: first contact position",
         "direction": "partial observability: direction to the true pose",
     }.get(reveal, reveal)
-    return f"{task} ({observability})"
+    table = result.get("config", {}).get("table")  # a named table of the task, e.g. scaling
+    return f"{task} ({observability}), {table} table" if table else f"{task} ({observability})"
 
 
 def _pct(rate: float) -> str:

@@ -1,15 +1,18 @@
 """The datasets a table builds, as a table of steps: each is one ``igen-collect`` or ``igen-generate`` command.
 
-A task's table that needs another dataset (more generated interventions for a data-scaling row, a
-second geometry's demonstrations) adds a :class:`DataStep` and a :data:`VARIANT_PART` entry; the
-runner builds, in order, only the steps the chosen variants need.
+A task's table that needs another dataset (a second geometry's demonstrations) adds a
+:class:`DataStep` and a :data:`VARIANT_PART` entry; the runner builds, in order, only the steps the
+chosen variants need. Data-scaling rows need no entry: a sized variant ``igen_<n>`` or
+``source_int_<n>`` gets a step of its own, the same command as its unsized row's with ``n``
+episodes (same seed, so ``source_int_100`` starts with the 10 ``source_int`` episodes).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from igen_lerobot.core.paper import sized_variant
 from igen_lerobot.experiments.config_table import TableConfig
 
 LABELS = {
@@ -89,10 +92,29 @@ PART_STEPS = (
 )
 
 
+def variant_part(variant: str) -> str | None:
+    """The dataset a variant adds to D: its :data:`VARIANT_PART`, or its own for a sized variant."""
+    return variant if sized_variant(variant) else VARIANT_PART[variant]
+
+
+def variant_label(variant: str) -> str:
+    """A row's name in tables: ``I-Gen (200)`` for ``igen_200``."""
+    sized = sized_variant(variant)
+    return f"{LABELS[sized[0]]} ({sized[1]})" if sized else LABELS[variant]
+
+
+def sized_step(variant: str) -> DataStep:
+    """The step making a sized variant's data: its unsized row's step with ``n`` episodes."""
+    kind, n = sized_variant(variant)
+    unsized = next(step for step in PART_STEPS if step.name == kind)
+    return replace(unsized, name=variant, episodes=lambda cfg: n)
+
+
 def needed_parts(variants: list[str], steps: tuple[DataStep, ...] = PART_STEPS) -> list[DataStep]:
-    """The part steps the variants need, their sources included, in table order."""
+    """The part steps the variants need, their sources included, in table order (sized rows last)."""
+    steps = (*steps, *(sized_step(v) for v in variants if sized_variant(v)))
     by_name = {step.name: step for step in steps}
-    wanted = {VARIANT_PART[v] for v in variants} - {None}
+    wanted = {variant_part(v) for v in variants} - {None}
     pending = list(wanted)
     while pending:
         source = by_name[pending.pop()].source

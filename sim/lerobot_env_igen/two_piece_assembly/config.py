@@ -21,7 +21,8 @@ class TwoPieceAssemblyEnvConfig(InHandInsertionEnvConfig):
     """2-Piece Assembly with the paper's receptacle position error (+-4 cm per axis, at least 1 cm in one).
 
     Examples: ``lerobot-eval --env.type=two_piece_assembly --policy.path=.../pretrained_model``;
-    the partial-observability variant: ``--env.reveal=direction``.
+    the partial-observability variant: ``--env.reveal=direction``; the data-scaling table:
+    ``igen-table --task=two_piece_assembly --table=scaling``.
     """
 
     base_spec = SPEC
@@ -46,6 +47,14 @@ class TwoPieceAssemblyEnvConfig(InHandInsertionEnvConfig):
             rows=("base", "source_int", "mg_demo", "igen_no_policy", "igen"),
             success={"base": 6, "source_int": 6, "mg_demo": 22, "igen_no_policy": 42, "igen": 66},
             caption="partial observability: the unit vector towards the true receptacle position at first contact",
+        ),
+        PaperTable(
+            name="scaling",
+            reveal=Reveal.FULL,
+            rows=("source_int_100", "igen_200", "igen_1000", "igen_5000"),
+            success={"source_int_100": 46, "igen_200": 34, "igen_1000": 70, "igen_5000": 88},
+            caption="data scaling: I-Gen with 200 / 1000 / 5000 generated interventions from the same 10 sources, "
+            "against 100 operator interventions",
         ),
     )
 
