@@ -224,3 +224,31 @@ def test_a_table_recorded_before_a_setting_existed_resumes_with_its_default(tmp_
     del recorded["table"]
     (out / "table_config.json").write_text(json.dumps(recorded))
     check_resumed_config(TableConfig(output_dir=str(out), variants=["base"]))
+
+
+def test_the_main_table_across_tasks_has_a_column_per_task_with_all_seven_rows():
+    """Tables of the main shape (all seven variants, full observability, not a named table) become one
+    combined table, ours (paper) and the interval per cell; other tables stay out of it."""
+    from igen_lerobot.experiments.table_report import render_main_table
+    from igen_lerobot.experiments.table_steps import variant_label
+
+    def table(task, variants, reveal="full", named=""):
+        rows = [
+            {"variant": v, "label": variant_label(v), "success_rate": (i + 1) / 10, "ci95": [i / 10, (i + 2) / 10],
+             "paper": 10 * i if task != "coffee" else None}
+            for i, v in enumerate(variants)
+        ]  # fmt: skip
+        return {"task": task, "reveal": reveal, "config": {"table": named}, "rows": rows}
+
+    nut, coffee = table("nut_insertion", VARIANTS), table("coffee", VARIANTS)
+    others = [
+        table("block_grasp", ("base", "source_int", "mg_demo", "igen_no_policy", "igen")),
+        table("nut_insertion", VARIANTS, reveal="contact_position"),
+        table("two_piece_assembly", ("source_int_100", "igen_200"), named="scaling"),
+    ]
+    lines = render_main_table([nut, *others, coffee])
+    assert lines[5] == "| Variant | Nut Insertion | Coffee |"
+    assert lines[7] == "| Base | 10% (0), 0–20% | 10% (–), 0–20% |"
+    assert lines[13] == "| I-Gen | 70% (60), 60–80% | 70% (–), 60–80% |" and len(lines) == 15
+    assert render_main_table([nut, *others]) == []  # one task: its own table says it all
+    assert render_main_table(others) == []

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from igen_lerobot.core.paper import VARIANTS
+
 SUPERSEDED = "superseded"  # subfolder of tables kept for the record: one seed, checkpoint chosen on the reported trials
 STUDY = "reproducibility.md"  # why earlier tables did not reproduce, measured: rendered after the page's introduction
 
@@ -91,6 +93,7 @@ def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str
         "those files.",
         "",
     ]
+    lines += render_main_table([result for result, _ in tables])
     for result, notes in tables:
         lines += render_markdown(result, notes)
     if study.strip():
@@ -107,6 +110,39 @@ def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str
         for result, notes in superseded:
             lines += render_superseded(result, notes)
     return "\n".join(lines)
+
+
+def is_main_table(result: dict) -> bool:
+    """The paper's main-table shape: all seven variants, full observability, not a named table."""
+    variants = {row["variant"] for row in result["rows"]}
+    return set(VARIANTS) <= variants and result.get("reveal") == "full" and not result["config"].get("table")
+
+
+def render_main_table(results: list[dict]) -> list[str]:
+    """The paper's main table across tasks: a column per task with a main-shaped table; none for fewer than two."""
+    tasks = [r for r in results if is_main_table(r)]
+    if len(tasks) < 2:
+        return []
+    names = " | ".join(r["task"].replace("_", " ").title() for r in tasks)
+    lines = [
+        "## Main table across tasks (full observability on contact)",
+        "",
+        "Each cell: ours (paper), mean test rate over training seeds, then its 95% interval; the tables",
+        "below give every seed and the protocol.",
+        "",
+        f"| Variant | {names} |",
+        "|---|" + "---|" * len(tasks),
+    ]
+    for variant in VARIANTS:
+        cells = []
+        for result in tasks:
+            row = next(r for r in result["rows"] if r["variant"] == variant)
+            low, high = row["ci95"]
+            paper = "–" if row["paper"] is None else row["paper"]
+            cells.append(f"{_pct(row['success_rate'])}% ({paper}), {_pct(low)}–{_pct(high)}%")
+        label = next(r["label"] for r in tasks[0]["rows"] if r["variant"] == variant)
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return [*lines, ""]
 
 
 def render_markdown(result: dict, notes: str = "") -> list[str]:
