@@ -113,3 +113,24 @@ def test_lerobot_train_and_lerobot_eval_run_on_the_task(data, tmp_path):
 
     info = lerobot_train_and_eval(data / "mimicgen", TASK, tmp_path)
     assert info["overall"]["n_episodes"] == 1
+
+
+def test_viz_draws_the_receptacle_where_it_was_believed_and_where_it_was(data, tmp_path):
+    """A generated recovery starts revealed (its belief column is the truth from frame 0), so igen-viz
+    also draws where the receptacle was believed before: the true pose moved by the episode's error."""
+    from test_viz import column, read_rrd
+
+    ok(run_here("igen-viz", f"--dataset.root={data / 'igen'}", "--episodes=[0]", f"--output={tmp_path / 'out.rrd'}"))
+    chunks = read_rrd(tmp_path / "out.rrd")
+    centres = {}
+    for which in ("true", "believed", "believed_before_reveal"):
+        entity = chunks[f"/episodes/0/receptacle/{which}"]
+        half = np.array(column(entity, "Boxes3D:half_sizes")[0][0])
+        np.testing.assert_allclose(half, [0.063, 0.063, 0.02], atol=1e-6)
+        centres[which] = np.array(column(entity, "Boxes3D:centers")[0][0])
+    spec = dataset_spec(data / "igen")
+    (episode,) = load_episodes(data / "igen", spec, episodes=[0])
+    np.testing.assert_allclose(centres["believed"], centres["true"], atol=1e-6)  # revealed from the start
+    # the paper's error, +-4 cm per axis with at least 1 cm in one (float32 in the recording: 1e-6 m)
+    np.testing.assert_allclose(centres["believed_before_reveal"] - centres["true"], episode.corruption, atol=1e-6)
+    assert 0.01 - 1e-6 <= np.abs(episode.corruption).max() <= 0.04 + 1e-6

@@ -74,3 +74,18 @@ def phase_colors(phases: np.ndarray) -> np.ndarray:
     """(N, 3) uint8 colours of ``phases``."""
     table = np.array([PHASE_COLORS[Phase(i)] for i in range(len(Phase))], dtype=np.uint8)
     return table[np.asarray(phases, dtype=int)]
+
+
+def believed_before_reveal(believed: np.ndarray, true: np.ndarray, corruption: np.ndarray, revealed: np.ndarray):
+    """Per frame, the corrupted object's pose (N, 7) as the robot believed it before any reveal.
+
+    The dataset's belief column says what the robot believed at each frame, so it already equals
+    the truth from the first frame of an episode that starts revealed (a generated recovery starts
+    at the contact). Views want to show where the mistake came from: for such an episode, the true
+    first pose moved by the episode's position error (``corruption``, 3 numbers); otherwise the
+    first frame's belief. Other error models (a flipped handle) keep the first frame's belief.
+    """
+    before = np.array(believed[0] if not revealed[0] or len(corruption) != 3 else true[0], dtype=float)
+    if revealed[0] and len(corruption) == 3:
+        before[:3] += np.asarray(corruption, dtype=float)
+    return np.tile(before, (len(believed), 1))

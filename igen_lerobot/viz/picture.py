@@ -15,18 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_phases
+from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, believed_before_reveal, frame_phases
 
 
 def believed_position(episode, k: int, revealed_flags: np.ndarray) -> np.ndarray:
-    """Where the robot believed object ``k`` was before the reveal.
-
-    The first frame's observed pose, unless the episode starts already revealed (a generated
-    recovery starts at the contact): then the true position plus the episode's position error.
-    """
-    if not revealed_flags[0] or len(episode.corruption) != 3:
-        return episode.env_state[0, 7 * k : 7 * k + 3]
-    return episode.true_object_pose[0, 7 * k : 7 * k + 3] + np.asarray(episode.corruption, float)
+    """Where the robot believed object ``k`` was before the reveal (see ``believed_before_reveal``)."""
+    poses = (a[:1, 7 * k : 7 * k + 7] for a in (episode.env_state, episode.true_object_pose))
+    return believed_before_reveal(*poses, episode.corruption, revealed_flags)[0, :3]
 
 
 def draw_episode(episode, spec, output: Path, title: str) -> None:

@@ -6,7 +6,9 @@ Layout (entity paths), one subtree per episode so episodes can be shown side by 
   (:mod:`igen_lerobot.viz.phases`), with a legend per phase in ``episodes/<i>/legend``;
 * ``episodes/<i>/eef``: the end effector on the ``frame`` timeline;
 * ``episodes/<i>/<object>/believed`` and ``.../true``: the object pose the robot believed and the
-  true one (boxes) on the ``frame`` timeline;
+  true one (boxes) on the ``frame`` timeline, and for the corrupted object
+  ``.../believed_before_reveal``: where it was believed before any contact (a generated recovery
+  starts revealed, so its ``believed`` is already the truth);
 * ``episodes/<i>/action/<name>`` and ``episodes/<i>/gripper``: scalar plots;
 * ``episodes/<i>/events``: first contact, takeover, end of episode (success or failure).
 
@@ -25,7 +27,14 @@ import numpy as np
 
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.task import TaskSpec
-from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, frame_phases, phase_colors
+from igen_lerobot.viz.phases import (
+    PHASE_COLORS,
+    PHASE_LABELS,
+    Phase,
+    believed_before_reveal,
+    frame_phases,
+    phase_colors,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -97,6 +106,7 @@ class EpisodeLogger:
         success: bool,
         kind: str = "",
         source_paths: dict[int, np.ndarray] | None = None,
+        corruption: np.ndarray | None = None,
     ) -> None:
         """One whole episode (arrays as in the dataset schema), sent column-wise on the ``frame`` timeline."""
         rr, stream = self.rr, self.stream
@@ -131,7 +141,11 @@ class EpisodeLogger:
         for k, obj in enumerate(self.spec.objects):
             believed = np.asarray(env_state, dtype=float)[:, 7 * k : 7 * k + 7]
             true = np.asarray(true_object_pose, dtype=float)[:, 7 * k : 7 * k + 7]
-            for name, poses, color in (("believed", believed, (219, 68, 55)), ("true", true, (15, 157, 88))):
+            boxes = [("believed", believed, (219, 68, 55)), ("true", true, (15, 157, 88))]
+            if obj == self.spec.corrupted_object and corruption is not None:  # where the mistake came from
+                boxes.append(("believed_before_reveal", believed_before_reveal(believed, true, corruption, revealed),
+                              (244, 160, 0)))  # fmt: skip
+            for name, poses, color in boxes:
                 stream.send_columns(
                     f"{root}/{obj}/{name}",
                     indexes=[frames],
@@ -208,6 +222,7 @@ class EpisodeLogger:
             episode.success,
             kind=episode.kind,
             source_paths=source_paths,
+            corruption=episode.corruption,
         )
 
     def log_outcome(self, index: int | str, success: bool, reason: str = "") -> None:
