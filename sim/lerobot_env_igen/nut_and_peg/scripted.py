@@ -18,7 +18,7 @@ import numpy as np
 
 from igen_lerobot.core.actions import ActionSpace
 from igen_lerobot.core.geometry import make_pose, pose_inv, rot_z, rotation_angle
-from lerobot_env_igen.nut_and_peg.spec import EMPTY_WIDTH, GRIP_X, HELD_WIDTH
+from lerobot_env_igen.nut_and_peg.spec import EMPTY_WIDTH, GRIP_X, HELD_WIDTH, PADS_ABOVE_NUT_CENTRE
 from lerobot_env_igen.panda import TOP_DOWN_ROT
 from lerobot_env_igen.panda_spec import PAD_ABOVE_GRIP, TABLE_TOP_Z
 from lerobot_env_igen.scripted import ClosedOnAirTakeover, WaypointRule, clipped_step
@@ -35,13 +35,13 @@ def yaw_of(rot: np.ndarray) -> float:
 def grasp_pose(T_world_nut: np.ndarray) -> np.ndarray:
     """Where the grip site goes to hold the handle.
 
-    ``GRIP_X`` out along the nut's x axis, the pads at its mid-height, the hand top-down and turned
-    to close across the handle (its yaw taken in (-pi/2, pi/2]).
+    ``GRIP_X`` out along the nut's x axis, the pads' centres ``PADS_ABOVE_NUT_CENTRE`` above its
+    mid-plane, the hand top-down and turned to close across the handle (its yaw taken in (-pi/2, pi/2]).
     """
     nut = T_world_nut[:3, 3]
     heading = yaw_of(T_world_nut[:3, :3])
     point = nut + GRIP_X * np.array([np.cos(heading), np.sin(heading), 0.0])
-    point[2] = nut[2] - PAD_ABOVE_GRIP
+    point[2] = nut[2] + PADS_ABOVE_NUT_CENTRE - PAD_ABOVE_GRIP
     hand_yaw = (heading + np.pi / 2) % np.pi - np.pi / 2  # a parallel gripper is symmetric under a half turn
     return make_pose(point, rot_z(hand_yaw) @ TOP_DOWN_ROT)
 
@@ -62,7 +62,7 @@ def square_turn(heading: float) -> float:
 class NutAndPegRule(WaypointRule):
     """Waypoint rule for grasping the handle and placing the nut; distances [m], speeds [m per 50 ms step]."""
 
-    hover: float = 0.06  # grip site above the grasp point while travelling to it
+    hover: float = 0.05  # grip site above the grasp point while travelling to it
     aligned: float = 0.003  # xy error of the hand under which it descends to the handle
     aligned_yaw: float = 0.03  # [rad] hand (or carried nut) yaw error under which it descends
     at_grasp: float = 0.005  # height error under which the fingers close
@@ -73,7 +73,8 @@ class NutAndPegRule(WaypointRule):
     release_above_table: float = (
         0.03  # the nut's bottom height above the table at which the fingers open (around the peg)
     )
-    travel_speed: float = 0.02
+    descend_xy_gain: float = 2.0  # the carried nut's xy error is commanded this many times while going down
+    travel_speed: float = 0.03
     descend_speed: float = 0.012
 
     def act(
@@ -123,7 +124,9 @@ class NutAndPegRule(WaypointRule):
             else:
                 goal_nut, speed = np.array([peg[0], peg[1], max(nut[2], lifted)]), self.travel_speed
         else:
-            goal_nut, speed = np.array([peg[0], peg[1], TABLE_TOP_Z + NUT_HALF_THICKNESS]), self.descend_speed
+            # going down, the arm lags the small sideways corrections: ask for twice the nut's xy error
+            down_at = peg[:2] + self.descend_xy_gain * (peg[:2] - nut[:2]) - (peg[:2] - nut[:2])
+            goal_nut, speed = np.array([*down_at, TABLE_TOP_Z + NUT_HALF_THICKNESS]), self.descend_speed
         T_goal_nut = make_pose(goal_nut, rot_z(turn) @ T_world_nut[:3, :3])
         T_goal_eef = T_goal_nut @ pose_inv(T_world_nut) @ T_world_eef
         return self._step(eef, T_goal_eef[:3, 3], T_goal_eef[:3, :3], speed, True)

@@ -21,6 +21,9 @@ PEG_XY = (0.23, 0.10)  # [m] robosuite's peg1, fixed
 # the grasp: fingers across the handle at GRIP_X out along the nut's x axis (the handle spans 2.875 to
 # 7.925 cm, the ring's outer edge is at 4.375 cm); the closed opening tells what is between them
 GRIP_X = 0.062  # [m]
+# the pads' centres this far above the nut's mid-plane: the fingers' lower ends clear the table (at
+# mid-height they rub on it and, closing on air, stall at 14-19 mm instead of closing fully)
+PADS_ABOVE_NUT_CENTRE = 0.006  # [m]
 HELD_WIDTH = (0.026, 0.036)  # [m] closed on the 3.175 cm handle: the opening lies in this range
 EMPTY_WIDTH = 0.01  # [m] closed on air: below this opening nothing is between the fingers
 EPISODE_STEPS = 400  # robomimic's Square horizon
