@@ -6,7 +6,7 @@ turns to close across the handle, descends, closes; once the fingers hold the ha
 opening in ``HELD_WIDTH``, at the grasp point) it lifts the nut clear of the peg, carries it over
 the peg while turning it square to the peg (:func:`square_turn`), lowers it, and opens once it
 is near the table. Fingers closed on air (a missed grasp: the handle is on the other side) make it
-open and rise, and try again where it believes the handle is: the base policy keeps closing on
+open fully and rise, and try again where it believes the handle is: the base policy keeps closing on
 air; the operator, which sees the true pose, goes across to the real handle.
 """
 
@@ -67,6 +67,7 @@ class NutAndPegRule(WaypointRule):
     aligned_yaw: float = 0.03  # [rad] hand (or carried nut) yaw error under which it descends
     at_grasp: float = 0.005  # height error under which the fingers close
     near_grasp: float = 0.012  # the hand within this of the grasp point: closing there, or holding
+    closing_height: float = 0.008  # partly closed fingers this near the grasp height are closing, higher opening
     clearance: float = 0.03  # nut bottom above the peg top while carrying
     on_axis: float = 0.003  # carried nut's xy error under which it goes down the peg
     keep_going: float = 0.006  # once below the peg top, a misalignment up to this still goes down
@@ -98,8 +99,11 @@ class NutAndPegRule(WaypointRule):
             return self._step(eef, rise, rot, self.travel_speed, False)
         if width < EMPTY_WIDTH:  # closed on air: open and rise
             return self._step(eef, rise, rot, self.travel_speed, False)
-        if at_handle and width < OPEN_WIDTH:  # closing on the handle: hold still
-            return self._step(eef, eef, rot, self.travel_speed, True)
+        if width < OPEN_WIDTH:
+            at_height = abs(eef[2] - g[2]) < self.closing_height
+            if at_height and float(np.linalg.norm(g[:2] - eef[:2])) < self.near_grasp:  # closing: hold still
+                return self._step(eef, eef, rot, self.travel_speed, True)
+            return self._step(eef, rise, rot, self.travel_speed, False)  # opening elsewhere: open fully, rise
         off = float(np.linalg.norm(g[:2] - eef[:2])) > self.aligned
         if off or rotation_angle(rot, grasp[:3, :3]) > self.aligned_yaw:
             if eef[2] < g[2] + self.hover - 0.02:  # too low to travel or turn: rise first
