@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from igen_lerobot.collection.record import record_demo, record_intervention
-from igen_lerobot.core.error_models import NoNoise, YawFlip
+from igen_lerobot.core.error_models import BoxNoise, NoNoise, YawFlip
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.core.task import FrameSource
@@ -75,7 +75,9 @@ def test_forced_geometries_and_a_balanced_mixture(env):
     with pytest.raises(ConfigError, match=r"env.geometry='3' is not one of \['1', '2', 'mixture'\]"):
         _config("3")
     with pytest.raises(ConfigError, match="use --env.corruption.type=flip"):
-        _config("2", corruption=NoNoise())
+        _config("2", corruption=BoxNoise())
+    truth = _config("2", corruption=NoNoise())  # demonstrations observe true poses, whatever the geometry
+    assert truth.corruption.names == ("flip",) and truth.task_spec.corruption_names == ("nut.flip",)
 
 
 def test_the_scripted_demonstration_succeeds_on_geometry_1_and_success_needs_release():
@@ -154,3 +156,17 @@ def test_the_scripted_operator_does_not_take_over_a_policy_on_geometry_1():
 def test_the_geometry_field_sets_only_the_flip_probability():
     config = dataclasses.replace(_config("2"), max_delta=0.02)
     assert config.corruption == YawFlip(probability=1.0) and config.max_delta == 0.02
+
+
+def test_igen_collect_records_demonstrations_in_the_flip_layout(tmp_path):
+    """Demonstrations observe true poses: igen-collect swaps the error for none, in the task's own layout."""
+    from igen_lerobot.collection.collect import collect
+    from igen_lerobot.collection.config_collect import CollectConfig
+    from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
+    from igen_lerobot.datasets.reader import load_episodes
+
+    config = _config("mixture")
+    dataset = DatasetOutputConfig(root=str(tmp_path / "demos"), repo_id="local/nut_and_peg_demos")
+    collect(CollectConfig(env=config, mode="demos", num_episodes=1, seed=3, dataset=dataset))
+    (episode,) = load_episodes(tmp_path / "demos", config.task_spec)
+    assert episode.success and np.asarray(episode.corruption).reshape(-1).tolist() == [0.0]

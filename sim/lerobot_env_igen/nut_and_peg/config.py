@@ -54,7 +54,8 @@ class NutAndPegEnvConfig(PandaTaskEnvConfig):
     corruption: ErrorModel = field(default_factory=paper_corruption)
     reveal: str = Reveal.NONE
     episode_length: int = EPISODE_STEPS
-    # 1 | 2 | mixture: force the flip's probability (0, 1, 0.5); None keeps --env.corruption's
+    # 1 | 2 | mixture: force the flip's probability (0, 1, 0.5); None keeps --env.corruption's; with
+    # --env.corruption.type=none (demonstrations on true poses) the robot sees the truth either way
     geometry: str | None = None
     nut_region: tuple[float, float] = NUT_REGION_EXTENTS  # [m] x, y extents of the nut's region
     max_rotation: float = 0.2  # [rad] per-step clip on the commanded end-effector rotation
@@ -66,7 +67,7 @@ class NutAndPegEnvConfig(PandaTaskEnvConfig):
                 raise ConfigError(f"env.geometry={self.geometry!r} is not one of {list(GEOMETRIES)}")
             if isinstance(self.corruption, YawFlip):
                 self.corruption = replace(self.corruption, probability=GEOMETRIES[self.geometry])
-            elif not (isinstance(self.corruption, NoNoise) and self.geometry == "1"):
+            elif not isinstance(self.corruption, NoNoise):  # true poses (demonstrations): no geometry error
                 raise ConfigError(
                     f"env.geometry={self.geometry} sets the flip error's probability, but "
                     f"env.corruption.type={self.corruption.type_name}; use --env.corruption.type=flip"
