@@ -170,3 +170,27 @@ def test_igen_collect_records_demonstrations_in_the_flip_layout(tmp_path):
     collect(CollectConfig(env=config, mode="demos", num_episodes=1, seed=3, dataset=dataset))
     (episode,) = load_episodes(tmp_path / "demos", config.task_spec)
     assert episode.success and np.asarray(episode.corruption).reshape(-1).tolist() == [0.0]
+
+
+def test_the_base_policy_places_a_nut_the_operator_regrasped_on_geometry_2():
+    """Control handed back after the grasp recovery: the policy still believes the handle is on the other
+    side, yet it sees the nut held (the opening) and places it; what generation relies on for subtask 2."""
+    config = _config("2")
+    env, policy, operator = config.make_task_env(), config.make_scripted_policy(), config.make_scripted_operator()
+    obs = env.reset(episode_seed(9, 0))
+    policy.reset()
+    operator.reset(env)
+    in_control, handed_back = False, None
+    for step in range(config.episode_length):
+        if handed_back is None:
+            in_control = operator.wants_control(env, in_control)
+            if in_control and env.subtask_index() == 1:  # the nut is held again: give it back
+                handed_back = step
+                policy.reset()
+        operator_acts = in_control and handed_back is None
+        info = env.step(operator.act(env) if operator_acts else policy.act(obs))
+        obs = env.observe()
+        if info.success:
+            break
+    assert handed_back is not None and info.success and env.corruption[0] == 1.0
+    env.close()

@@ -91,7 +91,9 @@ class NutAndPegRule(WaypointRule):
         eef, rot = T_world_eef[:3, 3], T_world_eef[:3, :3]
         grasp = grasp_pose(T_world_nut)
         g = grasp[:3, 3]
-        at_handle = float(np.linalg.norm(g - eef)) < self.near_grasp
+        # holding the handle, on whichever side it is: the fingers' opening says something is between them
+        other_side = grasp_pose(T_world_nut @ make_pose(np.zeros(3), rot_z(np.pi)))[:3, 3]
+        at_handle = min(np.linalg.norm(g - eef), np.linalg.norm(other_side - eef)) < self.near_grasp
         if at_handle and HELD_WIDTH[0] <= width <= HELD_WIDTH[1]:
             return self._carry(T_world_eef, T_world_nut, peg)
         rise = np.array([eef[0], eef[1], max(eef[2], g[2] + self.hover)])
@@ -115,8 +117,9 @@ class NutAndPegRule(WaypointRule):
     def _carry(self, T_world_eef: np.ndarray, T_world_nut: np.ndarray, peg: np.ndarray) -> tuple[np.ndarray, bool]:
         """The held nut: lift it clear, over the peg square to it, down, and open near the table."""
         eef, nut = T_world_eef[:3, 3], T_world_nut[:3, 3]
-        heading = yaw_of(T_world_nut[:3, :3])
-        turn = square_turn(heading)
+        # the handle's heading from where the hand holds it (right even where the nut's observed yaw is
+        # half a turn off); a half turn keeps the nut square to the peg, so either frame squares it
+        turn = square_turn(float(np.arctan2(eef[1] - nut[1], eef[0] - nut[0])))
         bottom = nut[2] - NUT_HALF_THICKNESS
         off = float(np.linalg.norm(peg[:2] - nut[:2]))
         if bottom < TABLE_TOP_Z + self.release_above_table and off < 3 * self.keep_going:
