@@ -11,7 +11,8 @@ nothing reveals it. 6-DOF delta-pose actions at 20 Hz, 400 steps.
   handle: the fingers close fully, on air, 1.8 cm beyond the ring's outer edge (the cue; see
   ``benchmarks/nut_and_peg_closed_width.py``).
 * Mistake signal: the fingers coming to rest closed on air (``EMPTY_WIDTH``) on this step.
-* Subtask progress: 0 until both finger pads hold the nut, 1 while it is held or on the peg, 2 on success.
+* Subtask progress: 0 while the nut lies on the table, 1 once both finger pads hold it and while it
+  is held, in the air or on the peg (dropped back on the table: 0, to be grasped again), 2 on success.
 * Success: robosuite's ``on_peg`` **and released** (no finger touches the nut).
 """
 
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
     from lerobot_env_igen.nut_and_peg.config import NutAndPegEnvConfig
 
 HOME_EEF_POS = (NUT_REGION_CENTER[0], NUT_REGION_CENTER[1] - 0.05, 1.0)  # [m] 19 cm above the nut region
+LIFTED = 0.01  # [m] the nut's centre this far above its resting height is off the table
 SETTLE_STEPS = 2  # control periods the dropped-in nut gets to come to rest at reset
 
 
@@ -89,7 +91,11 @@ class NutAndPegEnv(PandaTaskEnv):
         self._closed_on_air = empty
         return fired
 
+    def nut_lifted(self) -> bool:
+        """The nut is off the table: in the air or resting on the peg (not where the grasp starts again)."""
+        return bool(self.data.xpos[self.bodies["nut"]][2] > TABLE_TOP_Z + NUT_HALF_THICKNESS + LIFTED)
+
     def subtask_index(self) -> int:
         if self.is_success():
             return 2
-        return 1 if self.nut_held() or self.nut_on_peg() else 0
+        return 1 if self.nut_held() or self.nut_lifted() or self.nut_on_peg() else 0
