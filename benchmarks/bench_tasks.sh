@@ -10,7 +10,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 out=${1:-outputs/bench_tasks}
-tasks=(${IGEN_BENCH_TASKS:-block_grasp nut_insertion two_piece_assembly coffee})
+tasks=(${IGEN_BENCH_TASKS:-block_grasp nut_insertion two_piece_assembly coffee nut_and_peg})
 bin=.venv/bin
 mkdir -p "$out"
 for task in "${tasks[@]}"; do

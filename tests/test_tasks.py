@@ -22,7 +22,9 @@ TASKS = sorted(known_tasks())
 
 
 def test_the_shipped_tasks_and_the_fake_one_are_registered():
-    assert {"block_grasp", "nut_insertion", "two_piece_assembly", "coffee", "fake_pick_place"} <= set(TASKS)
+    assert {"block_grasp", "nut_insertion", "two_piece_assembly", "coffee", "nut_and_peg", "fake_pick_place"} <= set(
+        TASKS
+    )
 
 
 @pytest.fixture(params=TASKS)
@@ -96,7 +98,8 @@ def test_error_samples_obey_their_bounds_and_make_the_belief(config):
 def test_the_reveal_fires_on_the_declared_contact_and_not_before(config):
     spec = config.task_spec
     if spec.reveal_contact is None:
-        pytest.fail(f"{config.type} declares no reveal contact: give it a test of its own mistake signal")
+        _nothing_is_revealed_and_the_mistake_signal_fires(config)
+        return
     env, policy = config.make_task_env(), config.make_scripted_policy()
     revealed_episodes = 0
     for seed in range(4):
@@ -122,6 +125,39 @@ def test_the_reveal_fires_on_the_declared_contact_and_not_before(config):
             assert not info.mistake and obs[OBS_ENV_STATE][spec.env_state_index("revealed")] == 0.0
     assert config.reveal is Reveal.FULL
     assert revealed_episodes >= 3, "a base policy trusting a wrong pose should touch the object in most episodes"
+    env.close()
+
+
+def _nothing_is_revealed_and_the_mistake_signal_fires(config):
+    """A task without a reveal contact (Nut-and-Peg: its mistake is a grasp closing on air): the belief
+    stays the error model's for the whole episode, the observation carries no contact values, and the
+    task's own mistake signal fires for a base policy trusting a wrong pose in most episodes."""
+    spec = config.task_spec
+    assert config.reveal is Reveal.NONE and "revealed" not in spec.env_state_names
+    env, policy = config.make_task_env(), config.make_scripted_policy()
+    wrong_episodes = mistaken_episodes = 0
+    for seed in range(6):
+        obs = env.reset(seed)
+        policy.reset()
+        sample = env.corruption
+        wrong = not np.allclose(config.corruption.apply(np.eye(4), sample), np.eye(4))
+        wrong_episodes += wrong
+        for _ in range(config.episode_length):
+            info = env.step(policy.act(obs))
+            obs = env.observe()
+            truth = env.true_object_poses()[spec.corrupted_object]
+            np.testing.assert_allclose(
+                env.believed_object_poses()[spec.corrupted_object], config.corruption.apply(truth, sample), atol=1e-9
+            )
+            assert not info.revealed and not env.revealed and env.revealing_parts() is None
+            if info.mistake:
+                assert wrong, "the mistake signal fired though the robot believed the truth"
+                mistaken_episodes += 1
+                break
+            if info.success:
+                break
+    assert wrong_episodes >= 2, "pick seeds where the error model errs"
+    assert mistaken_episodes >= wrong_episodes - 1, "a base policy trusting a wrong pose should make the mistake"
     env.close()
 
 

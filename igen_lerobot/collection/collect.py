@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import draccus
@@ -39,7 +40,8 @@ def collect(cfg: CollectConfig) -> None:
     env_cfg: TaskEnvConfig = cfg.env  # type: ignore[assignment]  # checked in CollectConfig
     if cfg.mode == "demos" and cfg.demo_observation == "true" and not isinstance(env_cfg.corruption, NoNoise):
         logger.info("demos are recorded on true poses: overriding env.corruption with none")
-        env_cfg.corruption = NoNoise()
+        # replaced, not assigned: the config's checks give NoNoise the task's own error layout (``flip``)
+        env_cfg = dataclasses.replace(env_cfg, corruption=NoNoise())
     spec = env_cfg.task_spec
     cfg.render.check(spec)  # a camera the task lacks fails here, before anything is recorded
     repo_id, root = cfg.dataset.resolve(f"{spec.name}_{cfg.mode}")

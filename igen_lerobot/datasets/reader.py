@@ -144,7 +144,8 @@ def load_episodes(
                 task=spec.name,
                 kind=EpisodeKind.ALL[kind_index],
                 seed=int(col(EPISODE_SEED).reshape(-1)[0]),
-                corruption=col(CORRUPTION)[0].astype(float),
+                # a one-value error (Nut-and-Peg's flip) comes back from Arrow as a scalar per frame
+                corruption=col(CORRUPTION)[0].astype(float).reshape(len(spec.corruption_names)),
                 state=col(OBS_STATE).astype(float),
                 env_state=col(OBS_ENV_STATE).astype(float),
                 action=col(ACTION).astype(float),

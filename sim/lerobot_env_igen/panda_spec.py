@@ -15,6 +15,7 @@ TABLE_TOP_Z = 0.8  # [m] world height of the table surface
 PANDA_FPS = 20  # [Hz] the paper's control rate
 PANDA_EPISODE_STEPS = 200  # control steps in an episode, unless a task needs more
 GRIPPER = "gripper"  # the hand and fingers, as a contact party (``TaskSpec.reveal_contact``)
+PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site (top-down hand)
 
 POSITION_ACTION_NAMES = ("delta.x", "delta.y", "delta.z", "gripper")  # DeltaPositionActions
 POSE_ACTION_NAMES = ("delta.x", "delta.y", "delta.z", "delta.rx", "delta.ry", "delta.rz", "gripper")  # DeltaPoseActions

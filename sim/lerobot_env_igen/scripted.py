@@ -25,7 +25,15 @@ from igen_lerobot.core.geometry import pos_quat_to_pose
 from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE, TaskEnv, TaskSpec
 from lerobot_env_igen.panda_spec import GRIPPER
 
-__all__ = ["WaypointRule", "Takeover", "OffAxisTakeover", "ScriptedPolicy", "ScriptedOperator", "clipped_step"]
+__all__ = [
+    "WaypointRule",
+    "Takeover",
+    "OffAxisTakeover",
+    "ClosedOnAirTakeover",
+    "ScriptedPolicy",
+    "ScriptedOperator",
+    "clipped_step",
+]
 
 
 def clipped_step(eef: np.ndarray, target: np.ndarray, speed: float) -> np.ndarray:
@@ -89,6 +97,20 @@ class OffAxisTakeover:
         low = moving[2] - self.moving_bottom < target[2] + self.target_top + self.low_margin
         closing = self.closing_width is not None and env.gripper_width() < self.closing_width
         return off_axis and (env.contact or closing or low)
+
+
+@dataclass(frozen=True)
+class ClosedOnAirTakeover:
+    """Take over when the fingers are closed on air: opening below ``empty_width`` [m], nothing between them.
+
+    For tasks where nothing touches to reveal the mistake (Nut-and-Peg's handle on the other side):
+    the missed grasp itself, a fully closed gripper, is what a person watching would react to.
+    """
+
+    empty_width: float
+
+    def judges_mistake(self, env: TaskEnv) -> bool:
+        return env.gripper_width() < self.empty_width
 
 
 class ScriptedPolicy:

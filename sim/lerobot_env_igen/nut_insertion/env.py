@@ -21,9 +21,8 @@ import numpy as np
 
 from igen_lerobot.core.geometry import rot_z
 from lerobot_env_igen.in_hand_insertion import InHandInsertionEnv
-from lerobot_env_igen.nut_insertion.spec import NUT_HANDLE_GRIP_X, ON_PEG_XY, ON_PEG_Z, PEG_HALF
-from lerobot_env_igen.panda_spec import TABLE_TOP_Z
-from lerobot_env_igen.scene import box
+from lerobot_env_igen.nut_insertion.spec import NUT_HANDLE_GRIP_X
+from lerobot_env_igen.square_nut import HANDLE_HALF_WIDTH, on_peg, square_nut, square_peg
 
 if TYPE_CHECKING:
     from lerobot_env_igen.nut_insertion.config import NutInsertionEnvConfig
@@ -31,22 +30,13 @@ if TYPE_CHECKING:
 HOME_EEF_POS = (-0.062, 0.0, 1.0)  # [m] with the nut held, its centre is over the region's centre, 6 cm above the peg
 NUT_YAW = np.pi  # the handle points back towards the robot
 PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site
-HANDLE_HALF_WIDTH = 0.015875  # [m]
-PEG_RGBA = (0.55, 0.55, 0.6, 1.0)
-
-
-def square_nut():
-    """Robosuite's square nut (its model and meshes ship with robosuite, MIT)."""
-    from robosuite.models.objects import SquareNutObject
-
-    return SquareNutObject(name="nut")
 
 
 class NutInsertionEnv(InHandInsertionEnv):
     """The Nut Insertion task on the compiled robosuite Panda scene."""
 
     def __init__(self, config: NutInsertionEnvConfig) -> None:
-        super().__init__(config, square_nut(), box("peg", PEG_HALF, PEG_RGBA, fixed=True), HOME_EEF_POS)
+        super().__init__(config, square_nut(), square_peg(), HOME_EEF_POS)
 
     def place_in_hand(self, rng: np.random.Generator) -> None:
         # fingers across the handle, the pads' centres at the handle's mid-height
@@ -60,10 +50,7 @@ class NutInsertionEnv(InHandInsertionEnv):
     # ------------------------------------------------------------------ judges
     def nut_on_peg(self) -> bool:
         """Robosuite's ``on_peg``: the nut centre near the peg axis and down at the table."""
-        nut = self.data.xpos[self.bodies["nut"]]
-        peg = self.data.xpos[self.bodies["peg"]]
-        near = abs(nut[0] - peg[0]) < ON_PEG_XY and abs(nut[1] - peg[1]) < ON_PEG_XY
-        return bool(near and nut[2] < TABLE_TOP_Z + ON_PEG_Z)
+        return on_peg(self.data.xpos[self.bodies["nut"]], self.data.xpos[self.bodies["peg"]])
 
     def inserted(self) -> bool:
         return self.nut_on_peg()

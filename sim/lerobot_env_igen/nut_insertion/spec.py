@@ -4,16 +4,11 @@ from igen_lerobot.core.error_models import BoxNoise
 from igen_lerobot.core.task import ObjectBox
 from lerobot_env_igen.in_hand_insertion_spec import InsertionGeometry, in_hand_insertion_spec
 from lerobot_env_igen.panda_spec import TABLE_TOP_Z
+from lerobot_env_igen.square_nut import NUT_HALF_THICKNESS, PEG_CENTER_Z, PEG_HALF, PEG_TOP_Z
 
-# robosuite's square nut (models/assets/objects/square-nut.xml): a square ring 8.75 cm outside with
-# a 4.55 cm hole, 2 cm thick, and a handle box centred 5.4 cm out along the nut's x axis.
-NUT_HALF_THICKNESS = 0.01  # [m]
+__all__ = ["GEOMETRY", "SPEC", "paper_corruption", "NUT_HANDLE_GRIP_X", "PEG_TOP_Z"]
+
 NUT_HANDLE_GRIP_X = 0.062  # [m] where the fingers hold the handle, along the nut's x axis
-PEG_HALF = (0.016, 0.016, 0.065)  # [m] a 3.2 x 3.2 cm peg standing 13 cm tall (robosuite's peg1 width)
-PEG_CENTER_Z = TABLE_TOP_Z + PEG_HALF[2]
-PEG_TOP_Z = TABLE_TOP_Z + 2 * PEG_HALF[2]
-ON_PEG_XY = 0.03  # [m] robosuite's on_peg: nut centre within 3 cm of the peg axis in x and y ...
-ON_PEG_Z = 0.05  # [m] ... and below the table top + 5 cm
 
 GEOMETRY = InsertionGeometry(
     held="nut",
