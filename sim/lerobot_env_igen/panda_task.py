@@ -64,6 +64,9 @@ class PandaTaskEnv(TaskEnv):
         self.bodies = {name: self._body(roots.get(name, f"{name}_main")) for name in spec.objects}
         self.part_masks = {name: self.arm.geom_mask(self.collision_geoms(body)) for name, body in self.bodies.items()}
         self.part_masks[GRIPPER] = self.arm.gripper_geom_mask
+        pads = (self.arm.names.left_pad, self.arm.names.right_pad)
+        self._pad_ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in pads]
+        self._pad_mask = self.arm.geom_mask(self._pad_ids)
         self._free_qpos = {
             name: model.jnt_qposadr[model.body_jntadr[body]]
             for name, body in self.bodies.items()
@@ -132,6 +135,16 @@ class PandaTaskEnv(TaskEnv):
     def parts_in_contact(self, a: str, b: str) -> bool:
         """Whether two named parts (objects or ``gripper``) touch now."""
         return self.arm.in_contact(self.part_masks[a], self.part_masks[b])
+
+    def held_by_both_pads(self, part: str) -> bool:
+        """Both finger pads touch ``part`` now: a grasp, not one finger brushing it."""
+        mask, touching = self.part_masks[part], set()
+        for g1, g2 in self.data.contact.geom[: self.data.ncon]:
+            if mask[g1] and self._pad_mask[g2]:
+                touching.add(int(g2))
+            elif mask[g2] and self._pad_mask[g1]:
+                touching.add(int(g1))
+        return len(touching) == len(self._pad_ids)
 
     # ------------------------------------------------------------------ task hooks
     @abc.abstractmethod

@@ -41,11 +41,6 @@ class BlockGraspEnv(PandaTaskEnv):
         self._rest_z = TABLE_TOP_Z + CUBE_HALF
         self.cube_placer = RegionPlacer("cube", config.region(), z=self._rest_z)
         self._cube_body = self.bodies["cube"]
-        self._pad_ids = [
-            mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, n)
-            for n in (self.arm.names.left_pad, self.arm.names.right_pad)
-        ]
-        self._pads = self.arm.geom_mask(self._pad_ids)
 
     def place(self, rng: np.random.Generator) -> None:
         self.cube_placer.place(self, rng)
@@ -59,16 +54,7 @@ class BlockGraspEnv(PandaTaskEnv):
     # ------------------------------------------------------------------ judges
     def grasped(self) -> bool:
         """Both finger pads touch the cube."""
-        if self.data.ncon == 0:
-            return False
-        cube = self.part_masks["cube"]
-        touching = set()
-        for g1, g2 in self.data.contact.geom[: self.data.ncon]:
-            if cube[g1] and self._pads[g2]:
-                touching.add(int(g2))
-            elif cube[g2] and self._pads[g1]:
-                touching.add(int(g1))
-        return all(pad in touching for pad in self._pad_ids)
+        return self.held_by_both_pads("cube")
 
     def lift_height(self) -> float:
         """How far the cube is above its resting height [m]."""

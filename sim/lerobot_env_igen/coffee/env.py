@@ -44,12 +44,12 @@ from lerobot_env_igen.coffee.spec import (
     SEATED_Z,
 )
 from lerobot_env_igen.in_hand_insertion import InHandInsertionEnv
+from lerobot_env_igen.panda_spec import PAD_ABOVE_GRIP
 
 if TYPE_CHECKING:
     from lerobot_env_igen.coffee.config import CoffeeEnvConfig
 
 HOME_EEF_POS = (0.0, 0.0, 0.974)  # [m] the pod over the region's centre, its bottom 4 cm above the machine
-PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site
 GRIP_ABOVE_ORIGIN = POD_HALF_HEIGHT - 0.01  # [m] the pads' centres 1 cm below the pod's top
 POD_DENSITY = 300.0  # [kg/m^3] about 21 g
 POD_EDGES = 24  # vertices on each of the cone's two circles

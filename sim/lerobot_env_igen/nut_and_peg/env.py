@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from lerobot_env_igen.nut_and_peg.spec import EMPTY_WIDTH, NUT_REGION_CENTER, PEG_XY
@@ -43,10 +42,6 @@ class NutAndPegEnv(PandaTaskEnv):
     def __init__(self, config: NutAndPegEnvConfig) -> None:
         super().__init__(config, objects=[square_nut(), square_peg()], home_pos=HOME_EEF_POS)
         self.nut_region = config.region()
-        self._pad_ids = [
-            mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, n)
-            for n in (self.arm.names.left_pad, self.arm.names.right_pad)
-        ]
         self._closed_on_air = False
 
     def place(self, rng: np.random.Generator) -> None:
@@ -65,14 +60,7 @@ class NutAndPegEnv(PandaTaskEnv):
     # ------------------------------------------------------------------ judges
     def nut_held(self) -> bool:
         """Both finger pads touch the nut."""
-        nut = self.part_masks["nut"]
-        touching = set()
-        for g1, g2 in self.data.contact.geom[: self.data.ncon]:
-            if nut[g1] and g2 in self._pad_ids:
-                touching.add(int(g2))
-            elif nut[g2] and g1 in self._pad_ids:
-                touching.add(int(g1))
-        return len(touching) == len(self._pad_ids)
+        return self.held_by_both_pads("nut")
 
     def nut_on_peg(self) -> bool:
         return on_peg(self.data.xpos[self.bodies["nut"]], self.data.xpos[self.bodies["peg"]])

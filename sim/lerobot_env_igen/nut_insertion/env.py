@@ -22,6 +22,7 @@ import numpy as np
 from igen_lerobot.core.geometry import rot_z
 from lerobot_env_igen.in_hand_insertion import InHandInsertionEnv
 from lerobot_env_igen.nut_insertion.spec import NUT_HANDLE_GRIP_X
+from lerobot_env_igen.panda_spec import PAD_ABOVE_GRIP
 from lerobot_env_igen.square_nut import HANDLE_HALF_WIDTH, on_peg, square_nut, square_peg
 
 if TYPE_CHECKING:
@@ -29,7 +30,6 @@ if TYPE_CHECKING:
 
 HOME_EEF_POS = (-0.062, 0.0, 1.0)  # [m] with the nut held, its centre is over the region's centre, 6 cm above the peg
 NUT_YAW = np.pi  # the handle points back towards the robot
-PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site
 
 
 class NutInsertionEnv(InHandInsertionEnv):

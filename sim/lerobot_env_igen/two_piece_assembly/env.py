@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from lerobot_env_igen.in_hand_insertion import InHandInsertionEnv
+from lerobot_env_igen.panda_spec import PAD_ABOVE_GRIP
 from lerobot_env_igen.two_piece_assembly.spec import (
     FLOOR_Z,
     RECEPTACLE_SIZE,
@@ -37,7 +38,6 @@ if TYPE_CHECKING:
     from lerobot_env_igen.two_piece_assembly.config import TwoPieceAssemblyEnvConfig
 
 HOME_EEF_POS = (0.0, 0.0, 0.935)  # [m] the piece over the region's centre, its bottom 6.6 cm above the rim
-PAD_ABOVE_GRIP = 0.0036  # [m] the finger pads' centres sit this far above the grip site
 GRIP_ABOVE_ORIGIN = RIDGE_CENTER_Z + 0.005  # [m] the pads' centres above the piece's origin (upper ridge)
 PIECE_DENSITY = 400.0  # [kg/m^3] about 64 g
 PIECE_RGBA = ((0.2, 0.45, 0.8, 1.0), (0.9, 0.6, 0.1, 1.0))  # slab, ridge
