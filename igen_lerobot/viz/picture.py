@@ -20,8 +20,9 @@ from igen_lerobot.viz.phases import PHASE_COLORS, PHASE_LABELS, Phase, believed_
 
 def believed_position(episode, k: int, revealed_flags: np.ndarray) -> np.ndarray:
     """Where the robot believed object ``k`` was before the reveal (see ``believed_before_reveal``)."""
-    poses = (a[:1, 7 * k : 7 * k + 7] for a in (episode.env_state, episode.true_object_pose))
-    return believed_before_reveal(*poses, episode.corruption, revealed_flags)[0, :3]
+    believed = episode.env_state[:1, 7 * k : 7 * k + 7]
+    true = episode.true_object_pose[:1, 7 * k : 7 * k + 7]
+    return believed_before_reveal(believed, true, episode.corruption, revealed_flags)[0, :3]
 
 
 def draw_episode(episode, spec, output: Path, title: str) -> None:
