@@ -11,8 +11,10 @@ demo: setup
 
 # Two passes: everything but the wall-clock robot tests on both cores (pytest-xdist, one file per
 # worker), then the `realtime` ones alone so nothing steals the cycles their timing depends on.
+# --max-worker-restart=0: a worker ended by the per-test ceiling fails the run at once; xdist 3.8's
+# loadfile scheduling hangs after replacing a crashed worker (pytest-xdist#784, #1323).
 test: setup
-	@.venv/bin/python -m pytest -n 2 --dist loadfile -m "not realtime"
+	@.venv/bin/python -m pytest -n 2 --dist loadfile --max-worker-restart=0 -m "not realtime"
 	@.venv/bin/python -m pytest -m realtime
 
 lint: setup

@@ -150,7 +150,7 @@ def test_a_killed_render_resumes_without_ever_showing_a_half_written_dataset(dem
     assert not out.exists(), "no dataset may appear before the render finished"
     done = sorted(p.name for p in chunks.iterdir() if not p.name.endswith(".building"))
     assert 1 <= len(done) < 3, f"the kill must land mid-run: {done}"
-    resumed = subprocess.run(command, env=ENV, capture_output=True, text=True, timeout=600)
+    resumed = subprocess.run(command, env=ENV, capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr[-3000:]
     assert f"{len(done)} of 3 chunks already rendered" in resumed.stderr
     assert not out.with_name("out.partial").exists()
@@ -158,7 +158,7 @@ def test_a_killed_render_resumes_without_ever_showing_a_half_written_dataset(dem
     source = LeRobotDataset("local/d", root=demos)
     assert dataset.meta.total_episodes == 3 and dataset.meta.total_frames == source.meta.total_frames
     np.testing.assert_array_equal(np.asarray(dataset.hf_dataset["action"]), np.asarray(source.hf_dataset["action"]))
-    bad = subprocess.run([*command[:-3], "--cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=600)
+    bad = subprocess.run([*command[:-3], "--cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and "--cameras: task 'block_grasp' has no camera 'top'" in bad.stderr
     assert "Traceback" not in bad.stderr
 
@@ -187,7 +187,7 @@ def test_act_trains_on_a_rendered_dataset_and_lerobot_eval_runs_it_on_the_env_ca
         env=ENV,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
     )
     assert train.returncode == 0, train.stderr[-3000:]
     checkpoint = tmp_path / "train/checkpoints/last/pretrained_model"
@@ -209,7 +209,7 @@ def test_act_trains_on_a_rendered_dataset_and_lerobot_eval_runs_it_on_the_env_ca
         env=ENV,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
     )
     assert evaluation.returncode == 0, evaluation.stderr[-3000:]
     info = json.loads((tmp_path / "eval/eval_info.json").read_text())
@@ -229,11 +229,11 @@ def test_act_trains_on_a_rendered_dataset_and_lerobot_eval_runs_it_on_the_env_ca
         env=ENV,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
     )
     assert ours.returncode == 0, ours.stderr[-3000:]
     assert json.loads(out.read_text())["best"]["trials"] == 1
-    state_only = subprocess.run(igen_eval, env=ENV, capture_output=True, text=True, timeout=600)
+    state_only = subprocess.run(igen_eval, env=ENV, capture_output=True, text=True, timeout=300)
     assert state_only.returncode == 2, state_only.stderr[-3000:]
     fix = f"--env.obs_type=pixels_state --env.cameras='[agentview,wrist]' --env.image_size={SIZE}"
     assert fix in state_only.stderr
@@ -248,7 +248,7 @@ def test_igen_collect_renders_cameras_into_the_dataset_it_writes(tmp_path, demos
         env=headless_by_default,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
     )
     assert result.returncode == 0, "\n".join(line for line in result.stderr.splitlines() if "Svt" not in line)[-3000:]
     dataset = LeRobotDataset("local/collected", root=root)
@@ -264,7 +264,7 @@ def test_igen_collect_renders_cameras_into_the_dataset_it_writes(tmp_path, demos
         ("igen-generate", ["--task=block_grasp", f"--source.root={demos}", f"--dataset.root={tmp_path / 'x'}"]),
     ):
         bad = subprocess.run(
-            [str(BIN / command), *args, "--render.cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=600
+            [str(BIN / command), *args, "--render.cameras=[top]"], env=ENV, capture_output=True, text=True, timeout=300
         )
         flag = "--render.cameras: task 'block_grasp' has no camera 'top'; its cameras:"
         assert bad.returncode == 2 and flag in bad.stderr, bad.stderr[-2000:]

@@ -18,7 +18,7 @@ BIN = Path(sys.executable).parent
 
 def run(cmd, **kwargs):
     env = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
-    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600, **kwargs)
+    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300, **kwargs)
 
 
 def collect_cmd(root, n, seed=5, mode="interventions"):

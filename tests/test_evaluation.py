@@ -76,7 +76,7 @@ def test_igen_eval_evaluates_a_lerobot_train_run(bc_rnn_checkpoint, tmp_path):
         [str(BIN / "igen-eval"), "--task=block_grasp", f"--train_dir={train_dir}", "--n_trials=2", f"--output={out}"],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
         env=ENV,
     )
     assert result.returncode == 0, result.stderr[-3000:]

@@ -151,7 +151,7 @@ def test_igen_generate_cli_end_to_end(source_interventions, source_demos, tmp_pa
         f"--merge_with={source_demos}",
     ]
     result = subprocess.run(
-        cmd, capture_output=True, text=True, timeout=600, env={**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
+        cmd, capture_output=True, text=True, timeout=300, env={**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
     )
     assert result.returncode == 0, result.stderr[-3000:]
     assert "generation success rate" in result.stdout and "mean kept episode length" in result.stdout
@@ -162,7 +162,7 @@ def test_igen_generate_cli_end_to_end(source_interventions, source_demos, tmp_pa
         cmd[:3] + ["--source.root=" + str(source_demos), "--num_episodes=1", f"--dataset.root={tmp_path / 'bad'}"],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
         env={**os.environ, "MUJOCO_GL": "egl"},
     )
     assert bad.returncode == 2 and "no intervention frames" in bad.stderr

@@ -49,7 +49,7 @@ def collected(tmp_path_factory):
     root = tmp_path_factory.mktemp("hub") / "interventions"
     env = {**os.environ, "MUJOCO_GL": "egl"}
     args = ["--env.type=block_grasp", "--mode=interventions", "--num_episodes=3", f"--dataset.root={root}"]
-    result = subprocess.run([str(BIN / "igen-collect"), *args], env=env, capture_output=True, text=True, timeout=600)
+    result = subprocess.run([str(BIN / "igen-collect"), *args], env=env, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-3000:]
     return root
 
@@ -78,13 +78,13 @@ def env_for(hub, tmp_path, token=TOKEN, endpoint=None):
 
 
 def run(cmd, env):
-    return subprocess.run([str(BIN / cmd[0]), *cmd[1:]], env=env, capture_output=True, text=True, timeout=600)
+    return subprocess.run([str(BIN / cmd[0]), *cmd[1:]], env=env, capture_output=True, text=True, timeout=300)
 
 
 def read_back(hub, tmp_path, repo_id, local, revision=None, token=TOKEN):
     root = tmp_path / f"download_{repo_id.replace('/', '_')}_{revision or 'default'}_{token is None}"
     args = [str(BIN / "python"), "-c", READ_BACK, repo_id, str(root), str(local), *([revision] if revision else [])]
-    result = subprocess.run(args, env=env_for(hub, tmp_path, token), capture_output=True, text=True, timeout=600)
+    result = subprocess.run(args, env=env_for(hub, tmp_path, token), capture_output=True, text=True, timeout=300)
     return result
 
 
@@ -270,7 +270,7 @@ def test_live_push_to_the_real_hub(tmp_path, source_demos):
         env=env,
         capture_output=True,
         text=True,
-        timeout=900,
+        timeout=300,
     )
     assert result.returncode == 0, result.stderr[-3000:]
     assert json.loads(result.stdout.strip().splitlines()[-1])["worst"] == 0.0

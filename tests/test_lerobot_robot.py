@@ -153,7 +153,7 @@ FOLLOW_TOLERANCE = {"sim": 0.01, "franky": 0.02}
 
 
 def run(command: list[str], log: Path) -> None:
-    result = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
     log.write_text(result.stdout + result.stderr)
     assert result.returncode == 0, f"{command[0]} failed:\n{(result.stdout + result.stderr)[-3000:]}"
 

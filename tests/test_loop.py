@@ -28,7 +28,7 @@ def test_two_iterations_grow_the_dataset_and_resume_without_redoing(source_demos
         f"--output_dir={out}",
     ]
     env = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
-    first = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env)
+    first = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
     assert first.returncode == 0, first.stderr[-3000:]
     produced = json.loads(first.stdout[first.stdout.index("{") :])
     base = len(load_episodes(source_demos, SPEC))
@@ -46,7 +46,7 @@ def test_two_iterations_grow_the_dataset_and_resume_without_redoing(source_demos
     assert sizes == [base + 2, base + 4]  # D grows by n generated interventions per iteration
 
     stamp = (Path(produced["iterations"][0]["policy"]) / "model.safetensors").stat().st_mtime
-    again = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env)
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
     assert again.returncode == 0, again.stderr[-3000:]
     assert (Path(produced["iterations"][0]["policy"]) / "model.safetensors").stat().st_mtime == stamp
     assert "training already done" in again.stderr

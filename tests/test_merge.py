@@ -31,7 +31,7 @@ def test_weighted_repeats():
 
 def _merge(*args):
     return subprocess.run(
-        [str(BIN / "igen-merge"), "--task=block_grasp", *args], capture_output=True, text=True, timeout=600, env=ENV
+        [str(BIN / "igen-merge"), "--task=block_grasp", *args], capture_output=True, text=True, timeout=300, env=ENV
     )
 
 

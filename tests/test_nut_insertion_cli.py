@@ -27,7 +27,7 @@ BIN = Path(sys.executable).parent
 NUT = "--env.type=nut_insertion"
 
 
-def run(*cmd, timeout=600):
+def run(*cmd, timeout=300):
     env = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
     return subprocess.run([str(BIN / cmd[0]), *cmd[1:]], env=env, capture_output=True, text=True, timeout=timeout)
 

@@ -126,7 +126,7 @@ def test_live_logging_during_generation(source_interventions, tmp_path):
         ],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
         check=False,
     )
     assert result.returncode == 0, result.stderr[-3000:]
@@ -153,7 +153,7 @@ def test_live_logging_during_evaluation(tmp_path):
         ],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=300,
         check=False,
     )
     assert result.returncode == 0, result.stderr[-3000:]
