@@ -96,10 +96,18 @@ class ConsistencyChecker:
     def __init__(self, intrinsics: Intrinsics, T_base_camera: np.ndarray, size: float, config: ConsistencyConfig):
         self.intrinsics = intrinsics
         self.T_base_camera = np.asarray(T_base_camera, dtype=float)
+        self.T_camera_base = np.linalg.inv(self.T_base_camera)
         self.camera_position = self.T_base_camera[:3, 3]
+        # each pixel column's and row's ray slope: a face's model depth over a pixel box is then a
+        # broadcast of two vectors (free_space runs a few dozen times per frame while sliding fits)
+        self.ray_x = (np.arange(intrinsics.width) - intrinsics.cx) / intrinsics.fx
+        self.ray_y = (np.arange(intrinsics.height) - intrinsics.cy) / intrinsics.fy
         self.half = size / 2
         self.config = config
         self.faces = self._faces(size, config.face_inset)
+        self.face_normals = np.array([normal for normal, _ in self.faces])
+        self.face_centres = self.face_normals * self.half
+        self.face_corners = np.array([corners for _, corners in self.faces])
         self.corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float) * self.half
 
     @staticmethod
@@ -127,22 +135,22 @@ class ConsistencyChecker:
         where "seen" means valid depth not nearer than the model (not hidden by something in front).
         """
         cfg, K = self.config, self.intrinsics
-        T_camera_cube = np.linalg.inv(self.T_base_camera) @ T_base_cube
+        T_camera_cube = self.T_camera_base @ T_base_cube
         R, t = T_camera_cube[:3, :3], T_camera_cube[:3, 3]
-        camera_in_cube = -R.T @ t
+        # all six faces at once: which are turned to the camera, and their corners in the image
+        to_camera = -R.T @ t - self.face_centres
+        facing = np.einsum("ij,ij->i", self.face_normals, to_camera) > cfg.min_face_cosine * np.linalg.norm(
+            to_camera, axis=1
+        )
+        in_camera = self.face_corners @ R.T + t  # (face, corner, xyz)
+        facing &= (in_camera[:, :, 2] > 0).all(axis=1)
+        z = np.where(in_camera[:, :, 2] > 0, in_camera[:, :, 2], 1.0)
+        all_pixels = np.stack([K.fx * in_camera[:, :, 0] / z + K.cx, K.fy * in_camera[:, :, 1] / z + K.cy], axis=2)
+        face_normals_cam = self.face_normals @ R.T
+        face_offsets = np.einsum("ij,ij->i", face_normals_cam, self.face_centres @ R.T + t)
         behind = seen = 0
-        for normal, corners in self.faces:
-            centre = normal * self.half
-            to_camera = camera_in_cube - centre
-            if normal @ to_camera / np.linalg.norm(to_camera) <= cfg.min_face_cosine:
-                continue
-            in_camera = corners @ R.T + t
-            if (in_camera[:, 2] <= 0).any():
-                continue
-            pixels = np.stack(
-                [K.fx * in_camera[:, 0] / in_camera[:, 2] + K.cx, K.fy * in_camera[:, 1] / in_camera[:, 2] + K.cy],
-                axis=1,
-            )
+        for face in np.flatnonzero(facing):
+            pixels, n_cam = all_pixels[face], face_normals_cam[face]
             low = np.floor(pixels.min(axis=0)).astype(int)
             high = np.ceil(pixels.max(axis=0)).astype(int)
             low = np.maximum(low, 0)
@@ -151,15 +159,13 @@ class ConsistencyChecker:
                 continue
             mask = np.zeros((high[1] - low[1] + 1, high[0] - low[0] + 1), np.uint8)
             cv2.fillConvexPoly(mask, np.round(pixels - low).astype(np.int32), 1)
-            rows, cols = np.nonzero(mask)
-            rows, cols = rows + low[1], cols + low[0]
-            rays = np.stack([(cols - K.cx) / K.fx, (rows - K.cy) / K.fy, np.ones(rows.size)], axis=1)
-            n_cam = R @ normal
-            model = (n_cam @ (R @ centre + t)) / (rays @ n_cam)
-            measured = depth[rows, cols]
-            valid = measured > 0
-            behind += int((valid & (measured > model + cfg.free_space_tolerance)).sum())
-            seen += int((valid & (measured > model - cfg.free_space_tolerance)).sum())
+            # over the face's pixel box: the depth along each pixel's ray where it meets the face's plane
+            slope = n_cam[0] * self.ray_x[low[0] : high[0] + 1] + n_cam[1] * self.ray_y[low[1] : high[1] + 1, None]
+            model = face_offsets[face] / (slope + n_cam[2])
+            measured = depth[low[1] : high[1] + 1, low[0] : high[0] + 1]
+            on_face = mask.astype(bool) & (measured > 0)
+            behind += int(np.count_nonzero(on_face & (measured > model + cfg.free_space_tolerance)))
+            seen += int(np.count_nonzero(on_face & (measured > model - cfg.free_space_tolerance)))
         return (behind / seen if seen else 0.0), seen
 
     def explained(self, T_base_cube: np.ndarray, points: np.ndarray) -> np.ndarray:
