@@ -99,7 +99,7 @@ def collect(cfg: CollectConfig) -> None:
         cfg.num_episodes,
         metadata={
             "created_by": "igen-collect",
-            "origin": simulation_origin(env_cfg.task_spec.robot_type, env_cfg.package_name),
+            "origin": simulation_origin(env_cfg.task_spec.robot_type, env_cfg.package_name, env_cfg.randomization()),
             "mode": cfg.mode,
             "seed": cfg.seed,
             "operator": cfg.operator,

@@ -117,6 +117,10 @@ class TaskEnvConfig(EnvConfig, abc.ABC):
         """Static description shared by datasets, generator and policies (under this reveal mode)."""
         return self.base_spec.with_reveal(self.reveal)
 
+    def randomization(self) -> dict | None:
+        """What the task randomises per episode besides its scene and error (recorded with data), if anything."""
+        return None
+
     @property
     def package_name(self) -> str:
         return type(self).__module__.split(".")[0]

@@ -16,7 +16,7 @@ import shlex
 from pathlib import Path
 
 from igen_lerobot.core.task import TaskSpec
-from igen_lerobot.datasets.meta import origin_of, source_kinds
+from igen_lerobot.datasets.meta import SIM_CONTROLLER, origin_of, source_kinds
 from igen_lerobot.datasets.schema import SCHEMA_DOC_ROWS
 
 __all__ = ["card_fields", "card_tags", "CARD_TAGS", "SIMULATION_TAGS", "PAPER_URL", "CITATIONS"]
@@ -78,6 +78,22 @@ def _recorded(origin: dict, key: str) -> str:
     return f"`{value}`" if value else NOT_RECORDED
 
 
+def _randomization_text(origin: dict) -> str:
+    """The arm randomisation a simulated dataset records; for igen's own simulator, also that there was none."""
+    randomization = origin.get("randomization")
+    if not isinstance(randomization, dict):
+        ours = origin.get("controller") == SIM_CONTROLLER  # another package's simulator: not known, not said
+        return " The simulated arm was the same in every episode (no dynamics randomisation)." if ours else ""
+    said = {
+        "kp_scale": "controller stiffness x{}",
+        "latency_s": "action latency {} s",
+        "hand_tilt_deg": "hand tilt up to {} deg",
+        "eef_pos_noise_m": "hand-position observation noise {} m (std)",
+    }
+    parts = [text.format(randomization[key]) for key, text in said.items() if key in randomization]
+    return f" The arm was randomised per episode from its seed: {', '.join(parts)}."
+
+
 def _origin_line(origin: dict, meta: dict, info: dict) -> str:
     """One bullet saying where the data comes from, only as far as its metadata says."""
     kind = origin.get("kind")
@@ -86,7 +102,7 @@ def _origin_line(origin: dict, meta: dict, info: dict) -> str:
         return (
             f"- **Source**: simulation (simulator: {_recorded(origin, 'simulator')}{models}; task package "
             f"{_recorded(origin, 'task_package')}); robot {_recorded(origin, 'robot')}; controller: "
-            f"{origin.get('controller') or NOT_RECORDED}."
+            f"{origin.get('controller') or NOT_RECORDED}.{_randomization_text(origin)}"
         )
     if kind == "import":
         line = (

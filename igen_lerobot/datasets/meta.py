@@ -97,11 +97,12 @@ def _requires(distribution: str, name: str) -> bool:
     return any(r.split(";")[0].strip().lower().startswith(name) for r in requirements)
 
 
-def simulation_origin(robot: str, task_package: str) -> dict:
+def simulation_origin(robot: str, task_package: str, randomization: dict | None = None) -> dict:
     """``origin`` of data recorded or generated in one of igen's simulated tasks (``task_package``).
 
     The versions are the installed ones; ``models`` names robosuite where the task package is built
-    on it (its scenes are composed from robosuite's robot and object models).
+    on it (its scenes are composed from robosuite's robot and object models); ``randomization`` is
+    what the task drew per episode besides scene and error (its config's ``randomization()``).
     """
     mujoco = _version("mujoco")
     package = _version(task_package)
@@ -114,6 +115,8 @@ def simulation_origin(robot: str, task_package: str) -> dict:
     }
     if _requires(task_package, "robosuite"):
         origin["models"] = f"robosuite {_version('robosuite')}"
+    if randomization:
+        origin["randomization"] = randomization
     return origin
 
 

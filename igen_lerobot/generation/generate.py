@@ -145,7 +145,7 @@ def generate(cfg: GenerateConfig) -> None:
         cfg.num_episodes,
         metadata={
             "created_by": "igen-generate",
-            "origin": simulation_origin(spec.robot_type, env_cfg.package_name),
+            "origin": simulation_origin(spec.robot_type, env_cfg.package_name, env_cfg.randomization()),
             "mode": mode.value,
             "seed": cfg.seed,
             "source": str(source_root),

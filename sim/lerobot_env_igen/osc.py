@@ -110,16 +110,20 @@ class OperationalSpaceController:
         self._d0, self._n = int(dof_ids[0]), len(dof_ids)
         self._qpos = slice(int(qpos_ids[0]), int(qpos_ids[0]) + len(qpos_ids))
         self._home = np.asarray(home_qpos, dtype=float)
-        gains = gains or OscGains()
-        self._kp = np.array([gains.kp_pos] * 3 + [gains.kp_ori] * 3)
-        self._kd = 2.0 * np.sqrt(self._kp) * gains.damping_ratio
-        self._kp_null = float(gains.kp_null)
-        self._kd_null = float(2.0 * np.sqrt(gains.kp_null))
+        self.set_gains(gains or OscGains())
         self._jacp = np.zeros((3, model.nv))
         self._jacr = np.zeros((3, model.nv))
         self._mass_full = np.zeros((model.nv, model.nv))
         self._bound: mujoco.MjData | None = None
         self._bound_views: tuple = ()
+
+    def set_gains(self, gains: OscGains) -> None:
+        """Track with other gains from the next torque on (critical damping follows the stiffness)."""
+        self.gains = gains
+        self._kp = np.array([gains.kp_pos] * 3 + [gains.kp_ori] * 3)
+        self._kd = 2.0 * np.sqrt(self._kp) * gains.damping_ratio
+        self._kp_null = float(gains.kp_null)
+        self._kd_null = float(2.0 * np.sqrt(gains.kp_null))
 
     def _views(self, data: mujoco.MjData) -> tuple:
         """Views into ``data``'s buffers (they live as long as ``data``), built once per MjData.

@@ -9,7 +9,7 @@ report where they first touched.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numba
@@ -89,10 +89,24 @@ class PandaArm:
         self.home_rot = np.asarray(home_rot, dtype=float)
         self.home_qpos = self._solve_home(default_qpos, np.asarray(home_pos, float))
         self.osc = OperationalSpaceController(model, self.site, self.arm_dofs, self.home_qpos, self.arm_qpos, gains)
+        self.gains = gains
+        self.latency_substeps = 0  # substeps of each period that still track the previous goal (set_dynamics)
         self.goal_pos = np.zeros(3)
         self.goal_rot = self.home_rot.copy()
         self._gripper_level = -1.0  # -1 open ... +1 closed
         self.peak_contact_force = 0.0  # [N] see control_period(measure_force=True)
+
+    def set_dynamics(self, kp_scale: float = 1.0, latency: float = 0.0) -> None:
+        """Another arm's response: stiffness times ``kp_scale``, goals applied ``latency`` [s] late.
+
+        The latency is rounded to whole physics substeps; it must be shorter than a control period.
+        """
+        scaled = replace(self.gains, kp_pos=self.gains.kp_pos * kp_scale, kp_ori=self.gains.kp_ori * kp_scale)
+        self.osc.set_gains(scaled)
+        substeps = int(round(latency / self.model.opt.timestep))
+        if not 0 <= substeps < self.substeps:
+            raise ValueError(f"latency {latency} s must be shorter than the control period")
+        self.latency_substeps = substeps
 
     # ------------------------------------------------------------------ kinematics
     def _gripper_geom_ids(self) -> np.ndarray:
@@ -205,6 +219,7 @@ class PandaArm:
         :attr:`peak_contact_force` is the largest :meth:`contact_force` seen during the period
         (what a real arm's external-force estimate would show).
         """
+        late_pos, late_rot = self.goal_pos, self.goal_rot  # what a late goal leaves the arm tracking
         self.goal_pos = np.asarray(goal_pos, dtype=float)
         if goal_rot is not None:
             self.goal_rot = np.ascontiguousarray(goal_rot, dtype=float)
@@ -219,9 +234,13 @@ class PandaArm:
         event: ContactEvent | None = None
         watching = watch is not None
         self.peak_contact_force = 0.0
-        for _ in range(self.substeps):
+        late = self.latency_substeps
+        for substep in range(self.substeps):
             step1(model, data)
-            data.ctrl[act] = torques(data, goal_pos, goal_rot)
+            if substep < late:
+                data.ctrl[act] = torques(data, late_pos, late_rot)
+            else:
+                data.ctrl[act] = torques(data, goal_pos, goal_rot)
             step2(model, data)
             if watching and data.ncon and _any_pair(data.contact.geom[: data.ncon], mask_a, mask_b):
                 event = self._first_contact(mask_a, mask_b)

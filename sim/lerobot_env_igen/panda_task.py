@@ -23,6 +23,7 @@ import numpy as np
 from igen_lerobot.core.belief import ObjectBelief, Reveal
 from igen_lerobot.core.observation import observation
 from igen_lerobot.core.task import StepInfo, TaskEnv
+from lerobot_env_igen.arm_randomization import NO_DRAW, ArmDraw
 from lerobot_env_igen.cameras import PANDA_CAMERAS
 from lerobot_env_igen.panda import TOP_DOWN_ROT, ContactEvent, PandaArm
 from lerobot_env_igen.panda_spec import GRIPPER
@@ -53,6 +54,9 @@ class PandaTaskEnv(TaskEnv):
         self.spec = spec
         self.action_space = action_space
         self.error_model = config.corruption
+        self.randomization = config.randomize
+        self.arm_draw: ArmDraw = NO_DRAW  # this episode's arm (reset draws it from the seed)
+        self._obs_noise: np.random.Generator | None = None
         self.max_delta = float(config.max_delta)
         model, default_qpos = build_panda_table_scene(objects)
         home = np.asarray(home_pos, dtype=float)
@@ -168,6 +172,7 @@ class PandaTaskEnv(TaskEnv):
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int, corruption: np.ndarray | None = None) -> dict[str, np.ndarray]:
         rng = np.random.default_rng(seed)
+        self._apply_arm_draw(self.randomization.draw(seed))
         self.arm.reset()
         self.place(rng)
         mujoco.mj_forward(self.model, self.data)
@@ -179,10 +184,17 @@ class PandaTaskEnv(TaskEnv):
         self._steps = 0
         return self.observe()
 
+    def _apply_arm_draw(self, draw: ArmDraw) -> None:
+        self.arm_draw = draw
+        self.arm.set_dynamics(draw.kp_scale, draw.latency)
+        self._obs_noise = np.random.default_rng(draw.noise_seed) if draw.eef_pos_noise else None
+
     def step(self, action: np.ndarray) -> StepInfo:
         action = self.action_space.checked(action, self.spec.name)
         target = self.action_space.target_pose(self.eef_pose(), action)
-        return self.step_to(target[:3, 3], self.action_space.gripper_closed(action), goal_rot=target[:3, :3])
+        # a randomised hand tilt only reaches position-only tasks (the config refuses it elsewhere)
+        goal_rot = self.arm_draw.tilt @ target[:3, :3] if self.randomization.hand_tilt_deg else target[:3, :3]
+        return self.step_to(target[:3, 3], self.action_space.gripper_closed(action), goal_rot=goal_rot)
 
     def step_to(
         self,
@@ -219,7 +231,10 @@ class PandaTaskEnv(TaskEnv):
 
     # ------------------------------------------------------------------ observation
     def observe(self) -> dict[str, np.ndarray]:
-        return observation(self.spec, self.eef_pose(), self.gripper_width(), self.believed_object_poses(), self.belief)
+        T_world_eef = self.eef_pose()
+        if self._obs_noise is not None:  # the policy sees the hand where a noisy estimate puts it
+            T_world_eef[:3, 3] += self._obs_noise.normal(0.0, self.arm_draw.eef_pos_noise, 3)
+        return observation(self.spec, T_world_eef, self.gripper_width(), self.believed_object_poses(), self.belief)
 
     def true_object_poses(self) -> dict[str, np.ndarray]:
         return {name: self.body_pose(body) for name, body in self.bodies.items()}
