@@ -21,10 +21,59 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
+import numba
 import numpy as np
 
 from lerobot_robot_igen.perception.camera_model import Intrinsics
+
+
+@numba.njit(cache=True)
+def _count_free_space(depth, corners, facing, normals, offsets, ray_x, ray_y, tolerance):  # pragma: no cover - compiled
+    """Count, over each facing face's pixels, the seen-through (``behind``) and the ``seen`` ones.
+
+    A face's pixels lie inside its 4 image corners, edges included; a pixel with valid depth is
+    behind when that depth lies beyond the face's plane by ``tolerance``, seen when not nearer than
+    the plane by ``tolerance``. The face's model depth at a pixel is where the pixel's ray (slopes
+    ``ray_x``, ``ray_y``) meets its plane ``normal . p = offset`` (camera frame).
+    """
+    height, width = depth.shape
+    behind = 0
+    seen = 0
+    for face in range(corners.shape[0]):
+        if not facing[face]:
+            continue
+        quad = corners[face]
+        x0, x1 = max(quad[:, 0].min(), 0), min(quad[:, 0].max(), width - 1)
+        y0, y1 = max(quad[:, 1].min(), 0), min(quad[:, 1].max(), height - 1)
+        if x1 <= x0 or y1 <= y0:
+            continue
+        # the quad's winding, so "inside" is the same side of every edge
+        area = 0
+        for k in range(4):
+            j = (k + 1) % 4
+            area += quad[k, 0] * quad[j, 1] - quad[j, 0] * quad[k, 1]
+        sign = 1 if area >= 0 else -1
+        nx, ny, nz, offset = normals[face, 0], normals[face, 1], normals[face, 2], offsets[face]
+        for y in range(y0, y1 + 1):
+            for x in range(x0, x1 + 1):
+                inside = True
+                for k in range(4):
+                    j = (k + 1) % 4
+                    edge = (quad[j, 0] - quad[k, 0]) * (y - quad[k, 1]) - (quad[j, 1] - quad[k, 1]) * (x - quad[k, 0])
+                    if sign * edge < 0:
+                        inside = False
+                        break
+                if not inside:
+                    continue
+                measured = depth[y, x]
+                if measured <= 0.0:
+                    continue
+                model = offset / (nx * ray_x[x] + ny * ray_y[y] + nz)
+                if measured > model + tolerance:
+                    behind += 1
+                if measured > model - tolerance:
+                    seen += 1
+    return behind, seen
 
 
 @dataclass(frozen=True)
@@ -109,6 +158,9 @@ class ConsistencyChecker:
         self.face_centres = self.face_normals * self.half
         self.face_corners = np.array([corners for _, corners in self.faces])
         self.corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float) * self.half
+        # load (or compile, once per checkout) the counting kernel now, not on the loop's first frame
+        _count_free_space(np.zeros((1, 1)), np.zeros((1, 4, 2), np.int64), np.zeros(1, np.bool_), np.zeros((1, 3)),
+                          np.zeros(1), self.ray_x, self.ray_y, 0.0)  # fmt: skip
 
     @staticmethod
     def _faces(size: float, inset: float) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -148,24 +200,16 @@ class ConsistencyChecker:
         all_pixels = np.stack([K.fx * in_camera[:, :, 0] / z + K.cx, K.fy * in_camera[:, :, 1] / z + K.cy], axis=2)
         face_normals_cam = self.face_normals @ R.T
         face_offsets = np.einsum("ij,ij->i", face_normals_cam, self.face_centres @ R.T + t)
-        behind = seen = 0
-        for face in np.flatnonzero(facing):
-            pixels, n_cam = all_pixels[face], face_normals_cam[face]
-            low = np.floor(pixels.min(axis=0)).astype(int)
-            high = np.ceil(pixels.max(axis=0)).astype(int)
-            low = np.maximum(low, 0)
-            high = np.minimum(high, [K.width - 1, K.height - 1])
-            if (high <= low).any():
-                continue
-            mask = np.zeros((high[1] - low[1] + 1, high[0] - low[0] + 1), np.uint8)
-            cv2.fillConvexPoly(mask, np.round(pixels - low).astype(np.int32), 1)
-            # over the face's pixel box: the depth along each pixel's ray where it meets the face's plane
-            slope = n_cam[0] * self.ray_x[low[0] : high[0] + 1] + n_cam[1] * self.ray_y[low[1] : high[1] + 1, None]
-            model = face_offsets[face] / (slope + n_cam[2])
-            measured = depth[low[1] : high[1] + 1, low[0] : high[0] + 1]
-            on_face = mask.astype(bool) & (measured > 0)
-            behind += int(np.count_nonzero(on_face & (measured > model + cfg.free_space_tolerance)))
-            seen += int(np.count_nonzero(on_face & (measured > model - cfg.free_space_tolerance)))
+        behind, seen = _count_free_space(
+            depth,
+            np.round(all_pixels).astype(np.int64),
+            facing,
+            face_normals_cam,
+            face_offsets,
+            self.ray_x,
+            self.ray_y,
+            cfg.free_space_tolerance,
+        )
         return (behind / seen if seen else 0.0), seen
 
     def explained(self, T_base_cube: np.ndarray, points: np.ndarray) -> np.ndarray:
