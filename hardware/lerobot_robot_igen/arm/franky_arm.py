@@ -36,10 +36,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from igen_lerobot.core.exceptions import ConfigError
-from lerobot_robot_igen.backends.franky_tracker import ImpedanceTracker
-from lerobot_robot_igen.backends.gripper_worker import GripperWorker
-from lerobot_robot_igen.config_arm import ArmBackendConfig
-from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError, DriverError, MotionTimeoutError
+from lerobot_robot_igen.arm.config_arm import ArmBackendConfig
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, ConnectionLostError, DriverError, MotionTimeoutError
+from lerobot_robot_igen.arm.franky_tracker import ImpedanceTracker
+from lerobot_robot_igen.arm.gripper_worker import GripperWorker
 
 logger = logging.getLogger(__name__)
 

@@ -4,13 +4,13 @@ One loop for the real arm and for its rehearsal in simulation. Each period:
 
 1. read the arm (task frame) — a measured pose outside the workspace stops it;
 2. read the cube pose; the estimator may reject the frame, and the loop's
-   :class:`~lerobot_robot_igen.pose_gate.PoseGate` rejects low-confidence estimates and jumps
+   :class:`~lerobot_robot_igen.perception.pose_gate.PoseGate` rejects low-confidence estimates and jumps
    the cube could not have made; a rejected frame is bridged by the last accepted estimate for
    at most ``max_pose_age`` seconds, then the arm stops (stale perception). Every rejection is
    recorded with its reason (JSON report, Rerun);
 3. contact = external force above ``contact_force_threshold``; the first contact reveals the pose;
 4. build the observation exactly as in training and ask the policy for an action;
-5. send the target through :class:`~lerobot_robot_igen.arm.SafeArm` (limits, watchdog);
+5. send the target through :class:`~lerobot_robot_igen.arm.safe_arm.SafeArm` (limits, watchdog);
 6. let the period pass (simulated arms step; real ones move while the loop sleeps).
 
 Any exception, Ctrl-C included, stops the arm before it propagates; faults end the episode
@@ -33,12 +33,12 @@ from igen_lerobot.core.observation import observation as build_observation
 from igen_lerobot.core.pacing import RatePacer
 from igen_lerobot.core.task import OBS_ENV_STATE, TaskSpec
 from lerobot_env_igen.block_grasp.spec import SPEC as BLOCK_GRASP_SPEC
-from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.driver import ArmState, DriverError
+from lerobot_robot_igen.arm.driver import ArmState, DriverError
+from lerobot_robot_igen.arm.safe_arm import SafeArm
+from lerobot_robot_igen.arm.safety import SafetyViolationError
 from lerobot_robot_igen.perception.cube_pose import PerceptionError
-from lerobot_robot_igen.pose_gate import PoseGate, PoseGateSettings
-from lerobot_robot_igen.pose_source import PoseReading, PoseSource
-from lerobot_robot_igen.safety import SafetyViolationError
+from lerobot_robot_igen.perception.pose_gate import PoseGate, PoseGateSettings
+from lerobot_robot_igen.perception.pose_source import PoseReading, PoseSource
 
 logger = logging.getLogger(__name__)
 

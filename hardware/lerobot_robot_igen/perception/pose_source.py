@@ -56,7 +56,7 @@ class FrankySimCubePose(PoseSource):
     """franky-sim's cube over its scene channel (a franky rehearsal's stand-in for the camera)."""
 
     def __init__(self, host: str, port: int) -> None:
-        from lerobot_robot_igen.backends.franky_sim_scene import FrankySimScene
+        from lerobot_robot_igen.arm.franky_sim_scene import FrankySimScene
 
         self.scene = FrankySimScene(host, port)
 

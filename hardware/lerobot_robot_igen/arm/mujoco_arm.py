@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError
-from lerobot_robot_igen.safety import SafetyViolationError
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, ConnectionLostError
+from lerobot_robot_igen.arm.safety import SafetyViolationError
 
 
 @dataclass

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import draccus
 
-from lerobot_robot_igen.driver import ArmDriver
+from lerobot_robot_igen.arm.driver import ArmDriver
 
 # Where a real, table-mounted arm's base sits in the task frame: the table top is z = 0.8 m in
 # training, and the cube region is centred 0.56 m in front of the base, as in the simulator.
@@ -43,10 +43,10 @@ class SimArmBackendConfig(ArmBackendConfig):
         return True
 
     def make_driver(self) -> ArmDriver:
-        from lerobot_robot_igen.backends.mujoco_arm import MujocoArm, MujocoArmConfig
+        from lerobot_robot_igen.arm.mujoco_arm import MujocoArm, MujocoArmConfig
 
         return MujocoArm(MujocoArmConfig(fps=self.fps))
 
 
 # Registers --robot.type=franky (its module imports franky only when a driver connects).
-from lerobot_robot_igen.backends import franky_arm as _franky_arm  # noqa: E402, F401
+from lerobot_robot_igen.arm import franky_arm as _franky_arm  # noqa: E402, F401

@@ -1,8 +1,8 @@
 """The arm as the deployment loop sees it: task-frame commands, every limit enforced here.
 
-:class:`SafeArm` wraps any :class:`~lerobot_robot_igen.driver.ArmDriver`. It converts between the
-task frame (where the policy acts, see :mod:`lerobot_robot_igen.safety`) and the robot base
-frame, refuses or limits commands with :class:`~lerobot_robot_igen.safety.SafetyGuard`, and runs
+:class:`SafeArm` wraps any :class:`~lerobot_robot_igen.arm.driver.ArmDriver`. It converts between the
+task frame (where the policy acts, see :mod:`lerobot_robot_igen.arm.safety`) and the robot base
+frame, refuses or limits commands with :class:`~lerobot_robot_igen.arm.safety.SafetyGuard`, and runs
 a watchdog thread that stops the arm when no command arrives for ``watchdog_timeout`` seconds
 of the arm's clock (wall time on a real arm, simulated time in a rehearsal), even if the loop
 itself hangs. Once stopped for a fault it refuses further commands until
@@ -16,8 +16,8 @@ import threading
 
 import numpy as np
 
-from lerobot_robot_igen.driver import ArmDriver, ArmState, DriverError
-from lerobot_robot_igen.safety import SafetyGuard, SafetyLimits, SafetyViolationError
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, DriverError
+from lerobot_robot_igen.arm.safety import SafetyGuard, SafetyLimits, SafetyViolationError
 
 logger = logging.getLogger(__name__)
 

@@ -20,9 +20,9 @@ from igen_lerobot.evaluation.config_eval import EVAL_SEED
 from igen_lerobot.training.policy_source import PolicySourceConfig
 from igen_lerobot.viz.rerun_log import RerunConfig
 from lerobot_env_igen.d415 import D415Noise
-from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
-from lerobot_robot_igen.pose_gate import PoseGateSettings
-from lerobot_robot_igen.safety import SafetyLimits
+from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
+from lerobot_robot_igen.arm.safety import SafetyLimits
+from lerobot_robot_igen.perception.pose_gate import PoseGateSettings
 
 
 @dataclass

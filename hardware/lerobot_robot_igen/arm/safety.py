@@ -1,4 +1,4 @@
-"""The motion limits, checked in one place whatever drives the robot (see :class:`~lerobot_robot_igen.arm.SafeArm`).
+"""The motion limits, checked in one place whatever drives the robot (see ``SafeArm``).
 
 Limits live in the **task frame** (the frame the policy was trained in: Block Grasp's table top is
 at z = 0.8 m, the cube region centred on x = y = 0), so one set of numbers guards the simulated

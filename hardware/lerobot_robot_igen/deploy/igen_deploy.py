@@ -18,8 +18,8 @@ import logging
 from pathlib import Path
 
 from igen_lerobot.scripts.cli import run_cli
-from lerobot_robot_igen.config_deploy import DeployConfig
-from lerobot_robot_igen.deploy import deploy
+from lerobot_robot_igen.deploy.config_deploy import DeployConfig
+from lerobot_robot_igen.deploy.trials import deploy
 
 logger = logging.getLogger(__name__)
 

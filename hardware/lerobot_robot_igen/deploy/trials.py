@@ -20,18 +20,18 @@ from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import evaluate, wilson_interval
 from igen_lerobot.training.policy_source import make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
-from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.belief import check_deployable, cube_belief
-from lerobot_robot_igen.config_deploy import (
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, DriverError
+from lerobot_robot_igen.arm.safe_arm import SafeArm
+from lerobot_robot_igen.deploy.belief import check_deployable, cube_belief
+from lerobot_robot_igen.deploy.config_deploy import (
     DeployConfig,
     FrankySimPerceptionConfig,
     RealSensePerceptionConfig,
     RenderedPerceptionConfig,
     TruthPerceptionConfig,
 )
-from lerobot_robot_igen.deploy_loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
-from lerobot_robot_igen.driver import ArmDriver, ArmState, DriverError
-from lerobot_robot_igen.pose_source import PoseSource
+from lerobot_robot_igen.deploy.loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
+from lerobot_robot_igen.perception.pose_source import PoseSource
 
 logger = logging.getLogger(__name__)
 
@@ -65,7 +65,7 @@ class GraspLiftJudge:
 
 def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
     """The configured cube pose source (sim sources need the simulated arm)."""
-    from lerobot_robot_igen import pose_source
+    from lerobot_robot_igen.perception import pose_source
 
     p = cfg.perception
     if isinstance(p, TruthPerceptionConfig):
@@ -75,8 +75,8 @@ def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
     if isinstance(p, RenderedPerceptionConfig):
         return pose_source.RenderedICPPose(driver, p.distance, p.azimuth_deg, p.elevation_deg, p.noise)
     if isinstance(p, RealSensePerceptionConfig):
+        from lerobot_robot_igen.cameras.realsense import RealSenseConfig, RealSenseRGBD
         from lerobot_robot_igen.perception.camera_model import load_extrinsics
-        from lerobot_robot_igen.realsense import RealSenseConfig, RealSenseRGBD
 
         T_base_camera = load_extrinsics(p.calibration)
         camera = RealSenseRGBD(RealSenseConfig(serial=p.serial, recording=p.recording))
@@ -279,7 +279,7 @@ def _trial_situations(env_cfg, cfg: DeployConfig) -> list[tuple[np.ndarray, np.n
 def _franky_sim_trial(driver, scene, situation, world_from_base: np.ndarray):
     """One igen-eval trial on franky-sim: the arm home, the cube where the trial has it; its pose error and judge."""
     from lerobot_env_igen.block_grasp.spec import CUBE_HALF
-    from lerobot_robot_igen.backends.franky_sim_scene import LIFT_SUCCESS
+    from lerobot_robot_igen.arm.franky_sim_scene import LIFT_SUCCESS
 
     T_world_cube, corruption = situation
     driver.move_home()
