@@ -17,12 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.core.exceptions import IgenError
+from lerobot_robot_igen.errors import HardwareError
 
 __all__ = ["ArmState", "ArmDriver", "DriverError", "ConnectionLostError", "MotionTimeoutError"]
 
 
-class DriverError(IgenError, RuntimeError):
+class DriverError(HardwareError):
     """The arm refused or aborted a command (e.g. a reflex); :meth:`ArmDriver.recover` may clear it."""
 
 

@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.exceptions import ConfigError
+from lerobot_robot_igen.errors import HardwareError
 
 
-class SafetyViolationError(IgenError, RuntimeError):
+class SafetyViolationError(HardwareError):
     """A command would break a safety limit; the robot must stop."""
 
 

@@ -33,9 +33,8 @@ from igen_lerobot.core.observation import observation as build_observation
 from igen_lerobot.core.pacing import RatePacer
 from igen_lerobot.core.task import OBS_ENV_STATE, TaskSpec
 from lerobot_env_igen.block_grasp.spec import SPEC as BLOCK_GRASP_SPEC
-from lerobot_robot_igen.arm.driver import ArmState, DriverError
+from lerobot_robot_igen.arm.driver import ArmState
 from lerobot_robot_igen.arm.safe_arm import SafeArm
-from lerobot_robot_igen.arm.safety import SafetyViolationError
 from lerobot_robot_igen.perception.cube_pose import PerceptionError
 from lerobot_robot_igen.perception.pose_gate import PoseGate, PoseGateSettings
 from lerobot_robot_igen.perception.pose_source import PoseReading, PoseSource
@@ -223,7 +222,7 @@ def run_episode(
             if judge(state, action):
                 outcome.success = True
                 break
-    except (SafetyViolationError, PerceptionError, DriverError, IgenError) as err:
+    except IgenError as err:  # a HardwareError (driver, safety, perception) or another deliberate stop
         arm.halt(str(err))
         outcome.fault = arm.fault or str(err)
         logger.warning("episode stopped at step %d: %s", outcome.steps, outcome.fault)
