@@ -42,7 +42,8 @@ def main() -> None:
     from igen_lerobot.core.belief import Reveal
     from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
-    from lerobot_robot_igen.arm.franky_arm import FrankyArm, FrankyArmConfig
+    from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
+    from lerobot_robot_igen.arm.franky_arm import FrankyArm
     from lerobot_robot_igen.arm.safe_arm import SafeArm
     from lerobot_robot_igen.deploy.belief import cube_belief
     from lerobot_robot_igen.deploy.config_deploy import DeployConfig

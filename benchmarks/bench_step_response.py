@@ -47,7 +47,7 @@ def make_driver(args: argparse.Namespace):
         from lerobot_robot_igen.arm.mujoco_arm import MujocoArm
 
         return MujocoArm()
-    from lerobot_robot_igen.arm.franky_arm import FrankyArmConfig
+    from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
 
     controller = {"controller": args.controller} if args.controller else {}
     return FrankyArmConfig(host=args.host, **controller).make_driver()

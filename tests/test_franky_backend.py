@@ -14,8 +14,9 @@ from franky_sim_server import franky_sim, free_loopback, stop
 
 from igen_lerobot.core.belief import Reveal
 from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ
+from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
 from lerobot_robot_igen.arm.driver import ConnectionLostError
-from lerobot_robot_igen.arm.franky_arm import FrankyArm, FrankyArmConfig
+from lerobot_robot_igen.arm.franky_arm import FrankyArm
 from lerobot_robot_igen.arm.safe_arm import SafeArm
 from lerobot_robot_igen.arm.safety import SafetyLimits
 from lerobot_robot_igen.deploy.belief import cube_belief

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lerobot_env_igen.osc import OscGains
-from lerobot_robot_igen.arm.franky_arm import FrankyArmConfig
+from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
 from lerobot_robot_igen.arm.mujoco_arm import MujocoArm
 from lerobot_robot_igen.arm.training_controller import TrainingController
 

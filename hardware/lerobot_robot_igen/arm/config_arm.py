@@ -46,7 +46,3 @@ class SimArmBackendConfig(ArmBackendConfig):
         from lerobot_robot_igen.arm.mujoco_arm import MujocoArm, MujocoArmConfig
 
         return MujocoArm(MujocoArmConfig(fps=self.fps))
-
-
-# Registers --robot.type=franky (its module imports franky only when a driver connects).
-from lerobot_robot_igen.arm import franky_arm as _franky_arm  # noqa: E402, F401
