@@ -354,7 +354,7 @@ def test_config_errors_name_the_field():
 
     @ArmBackendConfig.register_subclass("test_real")
     class RealLike(ArmBackendConfig):
-        def make_driver(self):
+        def make_driver(self, env_config=None):
             raise AssertionError
 
     with pytest.raises(ConfigError, match="perception.type=realsense"):
@@ -531,8 +531,8 @@ def test_a_run_that_cannot_start_its_next_trial_keeps_the_trials_it_ran(tmp_path
 
     @ArmBackendConfig.register_subclass("test_fails_second_reset")
     class FailsSecondResetConfig(SimArmBackendConfig):
-        def make_driver(self):
-            return FailsSecondReset()
+        def make_driver(self, env_config=None):
+            return FailsSecondReset(env_config=env_config)
 
     output = tmp_path / "report.json"
     cfg = DeployConfig(
@@ -550,3 +550,31 @@ def test_a_run_that_cannot_start_its_next_trial_keeps_the_trials_it_ran(tmp_path
     assert len(report["per_trial"]) == 1 and report["deployment"]["trials"] == 1
     assert len(report["per_trial_sim"]) == 1  # igen-eval's side covers the same trials
     assert "run stopped before trial 2 of 3" in capsys.readouterr().out
+
+
+def test_nut_insertion_rehearses_on_the_mujoco_arm_with_7d_actions():
+    """Nut Insertion deployed as I-Gen would deploy it: its own spec and 6-DOF action space, not Block Grasp's.
+
+    The MuJoCo arm hosts the task's scene (the nut starts in the closed hand) and the scripted
+    policy's 7-D actions turn the hand. Truth perception is the requirement: the cameras' estimator
+    perceives Block Grasp's cube only, and no perception of the nut or peg exists, so another task
+    rehearses with ``--perception.type=truth`` (a camera config is refused with that advice).
+    """
+    records = []
+    cfg = DeployConfig(
+        task="nut_insertion",
+        robot=SimArmBackendConfig(),
+        perception=TruthPerceptionConfig(),
+        trials=2,
+        compare_sim=True,
+    )
+    report = deploy(cfg, on_step=records.append)
+    assert report["deployment"]["trials"] == 2 and len(report["per_trial"]) == 2
+    assert report["deployment"]["faults"] == []
+    assert {r.action.shape for r in records} == {(7,)}
+    assert any(np.linalg.norm(r.action[3:6]) > 0 for r in records)  # the hand is turned, not only moved
+    assert records[0].state.gripper_width < 0.036  # the nut starts held
+    assert [t["success"] for t in report["per_trial"]] == report["per_trial_sim"]
+    assert all(t["revealed_at"] is not None for t in report["per_trial"])  # the nut-peg contact was felt
+    with pytest.raises(ConfigError, match="perception.type=truth"):
+        deploy(DeployConfig(task="nut_insertion", robot=SimArmBackendConfig(), trials=1))

@@ -27,14 +27,14 @@ class ArmBackendConfig(draccus.ChoiceRegistry, abc.ABC):
         return False
 
     @abc.abstractmethod
-    def make_driver(self) -> ArmDriver:
-        """The (not yet connected) driver."""
+    def make_driver(self, env_config=None) -> ArmDriver:
+        """The (not yet connected) driver; a simulated arm builds ``env_config``'s task scene, a real one ignores it."""
 
 
 @ArmBackendConfig.register_subclass("sim")
 @dataclass
 class SimArmBackendConfig(ArmBackendConfig):
-    """The Block Grasp scene in MuJoCo (rehearsal)."""
+    """The task's scene in MuJoCo (rehearsal; Block Grasp unless igen-deploy's --task says otherwise)."""
 
     fps: int = 20
 
@@ -42,7 +42,11 @@ class SimArmBackendConfig(ArmBackendConfig):
     def simulated(self) -> bool:
         return True
 
-    def make_driver(self) -> ArmDriver:
+    def make_driver(self, env_config=None) -> ArmDriver:
+        from dataclasses import replace
+
         from lerobot_robot_igen.arm.mujoco_arm import MujocoArm, MujocoArmConfig
 
-        return MujocoArm(MujocoArmConfig(fps=self.fps))
+        if env_config is not None:
+            env_config = replace(env_config, fps=self.fps)
+        return MujocoArm(MujocoArmConfig(fps=self.fps), env_config)

@@ -85,7 +85,7 @@ class FrankyArmConfig(ArmBackendConfig):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"--robot.{name} must be > 0, got {getattr(self, name)}")
 
-    def make_driver(self) -> ArmDriver:
+    def make_driver(self, env_config=None) -> ArmDriver:
         from lerobot_robot_igen.arm.franky_arm import FrankyArm
 
         return FrankyArm(self)

@@ -81,8 +81,14 @@ HAND_ORIENTATIONS = ("goal", "measured")  # --hand_orientation
 
 @dataclass
 class DeployConfig:
-    """Run a trained Block Grasp policy on an arm at 20 Hz for N trials."""
+    """Run a trained policy on an arm at 20 Hz for N trials.
 
+    ``--task`` names the policy's task (LeRobot's ``--env.type``): its spec and action space shape
+    the observations and actions. Cameras perceive Block Grasp's cube only; other tasks rehearse on
+    the simulated arm with ``--perception.type=truth``.
+    """
+
+    task: str = "block_grasp"
     policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # --policy.path=.../pretrained_model
     robot: ArmBackendConfig = field(default_factory=SimArmBackendConfig)
     perception: PerceptionConfig = field(default_factory=RenderedPerceptionConfig)
@@ -110,7 +116,8 @@ class DeployConfig:
     output: str | None = None  # JSON file for the results
     rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log every step
     # What the policy is told the hand's orientation is. "goal": the task's fixed goal orientation,
-    # which its controller holds (position-only actions cannot change it); "measured": the arm's
+    # which its controller holds (position-only actions cannot change it; 6-DOF tasks have none and
+    # observe the measured one); "measured": the arm's
     # reading. The training arm's reading carries its own dynamic tilt (a few tenths of a degree
     # while it moves), which a policy can learn to read and no other arm reproduces
     # (docs/benchmarks.md: a constant 0.2 degree tilt took the Block Grasp checkpoint from 19/20 to 4/20).

@@ -1,4 +1,4 @@
-r"""Deploy a trained Block Grasp policy at 20 Hz: on a real Franka, or rehearsed in simulation.
+r"""Deploy a trained policy at 20 Hz: on a real Franka (Block Grasp), or rehearsed in simulation (any task).
 
 Examples::
 
@@ -10,6 +10,9 @@ Examples::
     # a real FR3 through franky-control, a D415, the camera's calibration
     igen-deploy --policy.path=... --robot.type=franky --robot.host=172.16.0.2 \
         --perception.type=realsense --perception.calibration=calib/T_base_camera.json --trials=10
+
+    # another task's policy (7-D actions), rehearsed on the MuJoCo arm with the simulator's poses
+    igen-deploy --task=nut_insertion --robot.type=sim --perception.type=truth --trials=10
 
 """
 
