@@ -33,11 +33,11 @@ def _parts(policy_path):
 
 def run_trial(seed, policy, poses_factory, realtime, on_step=None):
     from igen_lerobot.core.belief import Reveal
-    from lerobot_robot_igen.arm import SafeArm
-    from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
-    from lerobot_robot_igen.belief import cube_belief
-    from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
-    from lerobot_robot_igen.safety import SafetyLimits
+    from lerobot_robot_igen.arm.mujoco_arm import MujocoArm
+    from lerobot_robot_igen.arm.safe_arm import SafeArm
+    from lerobot_robot_igen.arm.safety import SafetyLimits
+    from lerobot_robot_igen.deploy.belief import cube_belief
+    from lerobot_robot_igen.deploy.loop import LoopSettings, run_episode
 
     arm = MujocoArm()
     arm.connect()
@@ -69,10 +69,10 @@ def main() -> None:
     args = parser.parse_args()
 
     from igen_lerobot.core.seeding import episode_seed
-    from lerobot_robot_igen.deploy_loop import timing_stats
+    from lerobot_robot_igen.cameras.realsense import RealSenseConfig, RealSenseRGBD, record_rgbd
+    from lerobot_robot_igen.deploy.loop import timing_stats
     from lerobot_robot_igen.perception.camera_model import Intrinsics
-    from lerobot_robot_igen.pose_source import RealSenseICPPose, RenderedICPPose
-    from lerobot_robot_igen.realsense import RealSenseConfig, RealSenseRGBD, record_rgbd
+    from lerobot_robot_igen.perception.pose_source import RealSenseICPPose, RenderedICPPose
 
     policy = _parts(args.policy)
     work = Path(tempfile.mkdtemp(prefix="bench_deploy_"))

@@ -79,10 +79,11 @@ def leg(safe, arm, start: np.ndarray, goal: np.ndarray, profile: str) -> dict:
 
 
 def run(host: str, profile: str) -> list[dict]:
-    from lerobot_robot_igen.arm import SafeArm
-    from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
-    from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ
-    from lerobot_robot_igen.safety import SafetyLimits
+    from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ
+    from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
+    from lerobot_robot_igen.arm.franky_arm import FrankyArm
+    from lerobot_robot_igen.arm.safe_arm import SafeArm
+    from lerobot_robot_igen.arm.safety import SafetyLimits
 
     arm = FrankyArm(FrankyArmConfig(host=host, controller="trajectory"))
     arm.connect()

@@ -61,11 +61,12 @@ def start_server(kind: str, python: str | None, host: str) -> subprocess.Popen:
 
 
 def stream(host: str, factors: tuple[float, float, float]) -> dict:
-    from lerobot_robot_igen.arm import SafeArm
-    from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
-    from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ
-    from lerobot_robot_igen.driver import DriverError
-    from lerobot_robot_igen.safety import SafetyLimits
+    from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ
+    from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
+    from lerobot_robot_igen.arm.driver import DriverError
+    from lerobot_robot_igen.arm.franky_arm import FrankyArm
+    from lerobot_robot_igen.arm.safe_arm import SafeArm
+    from lerobot_robot_igen.arm.safety import SafetyLimits
 
     v, a, j = factors
     arm = FrankyArm(FrankyArmConfig(host=host, velocity_factor=v, acceleration_factor=a, jerk_factor=j))

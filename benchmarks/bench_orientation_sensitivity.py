@@ -66,7 +66,7 @@ def main() -> None:
     from igen_lerobot.evaluation.trials import evaluate
     from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
-    from lerobot_robot_igen.config_deploy import DeployConfig
+    from lerobot_robot_igen.deploy.config_deploy import DeployConfig
 
     torch.set_num_threads(1)
     env_cfg = BlockGraspEnvConfig()

@@ -42,13 +42,14 @@ def main() -> None:
     from igen_lerobot.core.belief import Reveal
     from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
-    from lerobot_robot_igen.arm import SafeArm
-    from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
-    from lerobot_robot_igen.belief import cube_belief
-    from lerobot_robot_igen.config_deploy import DeployConfig
-    from lerobot_robot_igen.deploy import _trial_situations, loop_settings
-    from lerobot_robot_igen.deploy_loop import run_episode
-    from lerobot_robot_igen.pose_source import PoseReading, PoseSource
+    from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
+    from lerobot_robot_igen.arm.franky_arm import FrankyArm
+    from lerobot_robot_igen.arm.safe_arm import SafeArm
+    from lerobot_robot_igen.deploy.belief import cube_belief
+    from lerobot_robot_igen.deploy.config_deploy import DeployConfig
+    from lerobot_robot_igen.deploy.loop import run_episode
+    from lerobot_robot_igen.deploy.trials import _trial_situations, loop_settings
+    from lerobot_robot_igen.perception.pose_source import PoseReading, PoseSource
 
     class FixedCube(PoseSource):
         def __init__(self, T_base_cube: np.ndarray) -> None:

@@ -44,10 +44,10 @@ def schedules() -> dict[str, np.ndarray]:
 
 def make_driver(args: argparse.Namespace):
     if args.backend == "sim":
-        from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
+        from lerobot_robot_igen.arm.mujoco_arm import MujocoArm
 
         return MujocoArm()
-    from lerobot_robot_igen.backends.franky_arm import FrankyArmConfig
+    from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
 
     controller = {"controller": args.controller} if args.controller else {}
     return FrankyArmConfig(host=args.host, **controller).make_driver()

@@ -107,7 +107,7 @@ def test_pose_from_a_realsense_recording_of_rendered_frames(scene, tmp_path):
     """Rendered frames -> librealsense recording -> RealSense pipeline playback -> ICP: the full
     perception path a D415 frame takes, with the truth known."""
     from lerobot_env_igen.rgbd import random_cube_view
-    from lerobot_robot_igen.realsense import RealSenseConfig, RealSenseRGBD, RecordingEndedError, record_rgbd
+    from lerobot_robot_igen.cameras.realsense import RealSenseConfig, RealSenseRGBD, RecordingEndedError, record_rgbd
 
     env, camera, intrinsics = scene
     rng = np.random.default_rng(7)

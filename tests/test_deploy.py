@@ -13,22 +13,22 @@ from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import evaluate
-from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
-from lerobot_robot_igen.belief import cube_belief
-from lerobot_robot_igen.config_arm import ArmBackendConfig
-from lerobot_robot_igen.config_deploy import (
+from lerobot_robot_igen.arm.config_arm import ArmBackendConfig
+from lerobot_robot_igen.arm.driver import ConnectionLostError, DriverError
+from lerobot_robot_igen.arm.mujoco_arm import MujocoArm
+from lerobot_robot_igen.arm.safe_arm import SafeArm
+from lerobot_robot_igen.arm.safety import SafetyLimits
+from lerobot_robot_igen.deploy.belief import cube_belief
+from lerobot_robot_igen.deploy.config_deploy import (
     DeployConfig,
     RealSensePerceptionConfig,
     SimArmBackendConfig,
     TruthPerceptionConfig,
 )
-from lerobot_robot_igen.deploy import deploy
-from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
-from lerobot_robot_igen.driver import ConnectionLostError, DriverError
+from lerobot_robot_igen.deploy.loop import LoopSettings, run_episode
+from lerobot_robot_igen.deploy.trials import deploy
 from lerobot_robot_igen.perception.cube_pose import CubeNotVisibleError, PoseRejectedError
-from lerobot_robot_igen.pose_source import SimTruthPose
-from lerobot_robot_igen.safety import SafetyLimits
+from lerobot_robot_igen.perception.pose_source import SimTruthPose
 
 SEED = 1_000_003
 
@@ -167,7 +167,7 @@ def test_the_policy_observes_the_goal_orientation_unless_told_to_observe_the_mea
 
 def test_rendered_camera_and_icp_in_the_loop():
     """A simulated D415 through the real ICP estimator drives a successful grasp."""
-    from lerobot_robot_igen.config_deploy import RenderedPerceptionConfig
+    from lerobot_robot_igen.deploy.config_deploy import RenderedPerceptionConfig
 
     cfg = DeployConfig(robot=SimArmBackendConfig(), perception=RenderedPerceptionConfig(), trials=1)
     report = deploy(cfg)
@@ -350,11 +350,11 @@ def test_watchdog_stops_an_arm_whose_loop_hangs():
 
 
 def test_config_errors_name_the_field():
-    from lerobot_robot_igen.config_arm import ArmBackendConfig
+    from lerobot_robot_igen.arm.config_arm import ArmBackendConfig
 
     @ArmBackendConfig.register_subclass("test_real")
     class RealLike(ArmBackendConfig):
-        def make_driver(self):
+        def make_driver(self, env_config=None):
             raise AssertionError
 
     with pytest.raises(ConfigError, match="perception.type=realsense"):
@@ -370,9 +370,9 @@ def test_config_errors_name_the_field():
 
 
 def test_camera_not_found_and_missing_calibration_are_clear(tmp_path):
-    from lerobot_robot_igen.deploy import make_pose_source
+    from lerobot_robot_igen.cameras.realsense import CameraError
+    from lerobot_robot_igen.deploy.trials import make_pose_source
     from lerobot_robot_igen.perception.camera_model import save_extrinsics
-    from lerobot_robot_igen.realsense import CameraError
 
     missing = DeployConfig(perception=RealSensePerceptionConfig(calibration=str(tmp_path / "none.json")))
     with pytest.raises(ConfigError, match="none.json"):
@@ -408,7 +408,7 @@ def rrd_rows(path) -> dict[str, int]:
 def test_deployment_logs_to_rerun(tmp_path):
     """Camera images, the segmented cloud, ICP change, commanded vs measured hand, every period."""
     from igen_lerobot.viz.rerun_log import RerunConfig
-    from lerobot_robot_igen.config_deploy import RenderedPerceptionConfig
+    from lerobot_robot_igen.deploy.config_deploy import RenderedPerceptionConfig
 
     out = tmp_path / "deploy.rrd"
     cfg = DeployConfig(
@@ -428,8 +428,8 @@ def test_deployment_logs_to_rerun(tmp_path):
 def test_a_missing_camera_leaves_no_arm_running(tmp_path):
     import threading
 
+    from lerobot_robot_igen.cameras.realsense import CameraError
     from lerobot_robot_igen.perception.camera_model import save_extrinsics
-    from lerobot_robot_igen.realsense import CameraError
 
     save_extrinsics(tmp_path / "calib.json", np.eye(4))
     perception = RealSensePerceptionConfig(serial="000000000000", calibration=str(tmp_path / "calib.json"))
@@ -488,7 +488,7 @@ def test_low_confidence_estimates_are_not_acted_on(sim_arm):
 
 
 def test_pose_gate_settings_name_the_field():
-    from lerobot_robot_igen.pose_gate import PoseGateSettings
+    from lerobot_robot_igen.perception.pose_gate import PoseGateSettings
 
     with pytest.raises(ConfigError, match="pose_gate.max_cube_speed"):
         PoseGateSettings(max_cube_speed=0.0)
@@ -498,7 +498,7 @@ def test_pose_gate_settings_name_the_field():
 
 def test_rejected_estimates_reach_rerun_and_the_report(tmp_path, monkeypatch):
     from igen_lerobot.viz.rerun_log import RerunConfig
-    from lerobot_robot_igen import deploy as deploy_module
+    from lerobot_robot_igen.deploy import trials as deploy_module
 
     monkeypatch.setattr(deploy_module, "make_pose_source", lambda cfg, driver: JumpingCamera(driver, every=3))
     out = tmp_path / "deploy.rrd"
@@ -527,12 +527,12 @@ class FailsSecondReset(MujocoArm):
 
 def test_a_run_that_cannot_start_its_next_trial_keeps_the_trials_it_ran(tmp_path, capsys):
     """The JSON report holds trial 1 and says why the run stopped before trial 2; the command exits non-zero."""
-    from lerobot_robot_igen.igen_deploy import deploy_main
+    from lerobot_robot_igen.deploy.igen_deploy import deploy_main
 
     @ArmBackendConfig.register_subclass("test_fails_second_reset")
     class FailsSecondResetConfig(SimArmBackendConfig):
-        def make_driver(self):
-            return FailsSecondReset()
+        def make_driver(self, env_config=None):
+            return FailsSecondReset(env_config=env_config)
 
     output = tmp_path / "report.json"
     cfg = DeployConfig(
@@ -550,3 +550,31 @@ def test_a_run_that_cannot_start_its_next_trial_keeps_the_trials_it_ran(tmp_path
     assert len(report["per_trial"]) == 1 and report["deployment"]["trials"] == 1
     assert len(report["per_trial_sim"]) == 1  # igen-eval's side covers the same trials
     assert "run stopped before trial 2 of 3" in capsys.readouterr().out
+
+
+def test_nut_insertion_rehearses_on_the_mujoco_arm_with_7d_actions():
+    """Nut Insertion deployed as I-Gen would deploy it: its own spec and 6-DOF action space, not Block Grasp's.
+
+    The MuJoCo arm hosts the task's scene (the nut starts in the closed hand) and the scripted
+    policy's 7-D actions turn the hand. Truth perception is the requirement: the cameras' estimator
+    perceives Block Grasp's cube only, and no perception of the nut or peg exists, so another task
+    rehearses with ``--perception.type=truth`` (a camera config is refused with that advice).
+    """
+    records = []
+    cfg = DeployConfig(
+        task="nut_insertion",
+        robot=SimArmBackendConfig(),
+        perception=TruthPerceptionConfig(),
+        trials=2,
+        compare_sim=True,
+    )
+    report = deploy(cfg, on_step=records.append)
+    assert report["deployment"]["trials"] == 2 and len(report["per_trial"]) == 2
+    assert report["deployment"]["faults"] == []
+    assert {r.action.shape for r in records} == {(7,)}
+    assert any(np.linalg.norm(r.action[3:6]) > 0 for r in records)  # the hand is turned, not only moved
+    assert records[0].state.gripper_width < 0.036  # the nut starts held
+    assert [t["success"] for t in report["per_trial"]] == report["per_trial_sim"]
+    assert all(t["revealed_at"] is not None for t in report["per_trial"])  # the nut-peg contact was felt
+    with pytest.raises(ConfigError, match="perception.type=truth"):
+        deploy(DeployConfig(task="nut_insertion", robot=SimArmBackendConfig(), trials=1))

@@ -13,15 +13,16 @@ import pytest
 from franky_sim_server import franky_sim, free_loopback, stop
 
 from igen_lerobot.core.belief import Reveal
-from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.backends.franky_arm import FrankyArm, FrankyArmConfig
-from lerobot_robot_igen.belief import cube_belief
-from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ
-from lerobot_robot_igen.deploy import GraspLiftJudge
-from lerobot_robot_igen.deploy_loop import LoopSettings, run_episode
-from lerobot_robot_igen.driver import ConnectionLostError
-from lerobot_robot_igen.pose_source import PoseReading, PoseSource
-from lerobot_robot_igen.safety import SafetyLimits
+from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ
+from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
+from lerobot_robot_igen.arm.driver import ConnectionLostError
+from lerobot_robot_igen.arm.franky_arm import FrankyArm
+from lerobot_robot_igen.arm.safe_arm import SafeArm
+from lerobot_robot_igen.arm.safety import SafetyLimits
+from lerobot_robot_igen.deploy.belief import cube_belief
+from lerobot_robot_igen.deploy.loop import LoopSettings, run_episode
+from lerobot_robot_igen.deploy.trials import GraspLiftJudge
+from lerobot_robot_igen.perception.pose_source import PoseReading, PoseSource
 
 TOP_DOWN_SITE = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])  # the policy's end-effector frame
 CUBE_BASE = (0.5, 0.0)
@@ -374,7 +375,7 @@ def _scene_port() -> int:
 
 
 def test_franky_sim_scene_channel_places_and_reports_the_cube():
-    from lerobot_robot_igen.backends.franky_sim_scene import FrankySimScene
+    from lerobot_robot_igen.arm.franky_sim_scene import FrankySimScene
 
     with franky_sim(cube=CUBE_BASE, scene_port=_scene_port()) as server:
         scene = FrankySimScene(server.host, server.scene_port)
@@ -396,8 +397,8 @@ def test_igen_deploy_rehearses_igen_evals_trials_through_franky_on_franky_sim():
     carries the sim comparison."""
     from igen_lerobot.core.seeding import episode_seed
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
-    from lerobot_robot_igen.config_deploy import DeployConfig, FrankySimPerceptionConfig
-    from lerobot_robot_igen.deploy import deploy
+    from lerobot_robot_igen.deploy.config_deploy import DeployConfig, FrankySimPerceptionConfig
+    from lerobot_robot_igen.deploy.trials import deploy
 
     # igen-eval's cubes for trials 0 and 1
     env = BlockGraspEnvConfig().make_task_env()
@@ -458,7 +459,7 @@ def test_a_move_home_that_does_not_finish_in_time_stops_the_arm_with_a_clear_err
     deadline it goes home (tolerance 5 mm)."""
     from dataclasses import replace
 
-    from lerobot_robot_igen.driver import MotionTimeoutError
+    from lerobot_robot_igen.arm.driver import MotionTimeoutError
 
     arm = connected(empty_sim)
     try:

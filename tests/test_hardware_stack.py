@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from igen_lerobot.core.exceptions import ConfigError
-from lerobot_robot_igen.safety import SafetyGuard, SafetyLimits, SafetyViolationError, Watchdog
+from lerobot_robot_igen.arm.safety import SafetyGuard, SafetyLimits, SafetyViolationError, Watchdog
 
 
 @pytest.mark.parametrize("module", ["pyrealsense2", "open3d", "franky"])

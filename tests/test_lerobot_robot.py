@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lerobot_robot_igen.safety import SafetyViolationError
+from lerobot_robot_igen.arm.safety import SafetyViolationError
 
 BIN = Path(sys.executable).parent
 FPS = 20
@@ -22,7 +22,7 @@ def make_robot(**overrides):
     from lerobot.robots.utils import make_robot_from_config
     from lerobot.utils.import_utils import register_third_party_plugins
 
-    from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
+    from lerobot_robot_igen.robots.config_igen_franka import IgenFrankaConfig
 
     register_third_party_plugins()
     return make_robot_from_config(IgenFrankaConfig(**overrides))

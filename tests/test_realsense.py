@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from igen_lerobot.core.exceptions import ConfigError, IgenError  # noqa: E402
-from lerobot_robot_igen.perception.camera_model import Intrinsics  # noqa: E402
-from lerobot_robot_igen.realsense import (  # noqa: E402
+from lerobot_robot_igen.cameras.realsense import (  # noqa: E402
     CameraError,
     RealSenseConfig,
     RealSenseRGBD,
@@ -17,6 +16,7 @@ from lerobot_robot_igen.realsense import (  # noqa: E402
     connected_serials,
     record_rgbd,
 )
+from lerobot_robot_igen.perception.camera_model import Intrinsics  # noqa: E402
 
 H, W, N = 480, 640, 5
 K = Intrinsics(width=W, height=H, fx=615.0, fy=615.0, cx=319.5, cy=239.5)
@@ -180,8 +180,8 @@ def test_a_recording_as_a_lerobot_camera_on_the_igen_franka_robot(recording):
     """LeRobot's camera configs reach our capture: type igen_realsense plays the recording, frame after frame."""
     from lerobot.robots.utils import make_robot_from_config
 
-    from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
-    from lerobot_robot_igen.config_recorded_realsense import RecordedRealSenseConfig
+    from lerobot_robot_igen.cameras.config_recorded_realsense import RecordedRealSenseConfig
+    from lerobot_robot_igen.robots.config_igen_franka import IgenFrankaConfig
 
     camera = RecordedRealSenseConfig(recording=str(recording), width=W, height=H, fps=30)
     robot = make_robot_from_config(IgenFrankaConfig(cameras={"front": camera}, home_on_connect=False))

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from lerobot_env_igen.osc import OscGains
-from lerobot_robot_igen.backends.franky_arm import FrankyArmConfig
-from lerobot_robot_igen.backends.mujoco_arm import MujocoArm
-from lerobot_robot_igen.backends.training_controller import TrainingController
+from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
+from lerobot_robot_igen.arm.mujoco_arm import MujocoArm
+from lerobot_robot_igen.arm.training_controller import TrainingController
 
 PERIOD = 0.05
 STEP_X = [np.array([0.01, 0.0, 0.0])] * 12 + [np.zeros(3)] * 4  # 1 cm per period, then stop

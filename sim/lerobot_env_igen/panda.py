@@ -187,6 +187,11 @@ class PandaArm:
         q = self.data.qpos[self.finger_qpos]
         return float(q[0] - q[1])
 
+    @property
+    def gripper_commanded_closed(self) -> bool:
+        """Whether the fingers are being closed (an in-hand task starts with them closed on its part)."""
+        return self._gripper_level > 0.0
+
     # ------------------------------------------------------------------ control
     def hold_closed(self, finger_opening: float) -> None:
         """Put the fingers at ``finger_opening`` [m] each, commanded closed (an object starts in the hand)."""

@@ -1,1 +1,1 @@
-"""Camera models, calibration and cube pose estimation (Open3D ICP) for the real Block Grasp setup."""
+"""Camera models, calibration, cube pose estimation (Open3D ICP) and the loop's pose sources and gate."""

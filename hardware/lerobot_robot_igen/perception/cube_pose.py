@@ -31,12 +31,12 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from igen_lerobot.core.exceptions import IgenError
+from lerobot_robot_igen.errors import HardwareError
 from lerobot_robot_igen.perception.camera_model import Intrinsics
 from lerobot_robot_igen.perception.consistency import Consistency, ConsistencyChecker, ConsistencyConfig
 
 
-class PerceptionError(IgenError, RuntimeError):
+class PerceptionError(HardwareError):
     """No trustworthy cube pose in this frame; the message says why (the loop must not act on it)."""
 
 

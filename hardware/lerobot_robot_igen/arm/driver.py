@@ -2,7 +2,7 @@
 
 A backend (franky-control for a real FR3/Panda, MuJoCo for the Block Grasp scene) only moves the
 arm: it reports its state and follows absolute Cartesian targets in the **robot base frame**.
-Limits (workspace, speed, watchdog) are not a backend's business: :class:`~lerobot_robot_igen.arm.SafeArm`
+Limits (workspace, speed, watchdog) are not a backend's business: :class:`~lerobot_robot_igen.arm.safe_arm.SafeArm`
 enforces them in one place for every backend.
 
 Units: metres, radians, seconds, newtons. Poses are 4x4 homogeneous matrices ``T_base_eef``; the
@@ -17,12 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from igen_lerobot.core.exceptions import IgenError
+from lerobot_robot_igen.errors import HardwareError
 
 __all__ = ["ArmState", "ArmDriver", "DriverError", "ConnectionLostError", "MotionTimeoutError"]
 
 
-class DriverError(IgenError, RuntimeError):
+class DriverError(HardwareError):
     """The arm refused or aborted a command (e.g. a reflex); :meth:`ArmDriver.recover` may clear it."""
 
 

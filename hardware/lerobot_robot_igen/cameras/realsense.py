@@ -22,11 +22,12 @@ from types import TracebackType
 import numpy as np
 import pyrealsense2 as rs
 
-from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.exceptions import ConfigError
+from lerobot_robot_igen.errors import HardwareError
 from lerobot_robot_igen.perception.camera_model import Intrinsics
 
 
-class CameraError(IgenError, RuntimeError):
+class CameraError(HardwareError):
     """The camera or recording cannot deliver frames; the message names the camera or file."""
 
 

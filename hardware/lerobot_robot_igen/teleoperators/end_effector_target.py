@@ -15,7 +15,7 @@ from functools import cached_property
 import numpy as np
 from lerobot.teleoperators.teleoperator import Teleoperator
 
-from lerobot_robot_igen.config_end_effector_target import EndEffectorTargetConfig
+from lerobot_robot_igen.teleoperators.config_end_effector_target import EndEffectorTargetConfig
 
 OPEN_WIDTH, CLOSED_WIDTH = 0.08, 0.0  # [m] gripper.pos targets
 GRIPPER_CLOSE, GRIPPER_OPEN = 0, 2

@@ -19,9 +19,14 @@ __all__ = ["PoseSource", "PoseReading", "SimTruthPose", "RenderedICPPose", "Real
 
 @dataclass
 class PoseReading:
-    """One estimate and, for cameras, the frame it came from (for logging)."""
+    """One estimate and, for cameras, the frame it came from (for logging).
+
+    ``T_base_cube`` is the pose of the object the task corrupts (Block Grasp's cube, Nut
+    Insertion's peg); ``T_base_objects`` the other objects' poses, from sources that know them.
+    """
 
     T_base_cube: np.ndarray
+    T_base_objects: dict[str, np.ndarray] = field(default_factory=dict)
     estimate: CubePoseEstimate | None = None
     color: np.ndarray | None = None
     depth: np.ndarray | None = None
@@ -43,20 +48,25 @@ class PoseSource(abc.ABC):
 
 
 class SimTruthPose(PoseSource):
-    """The simulator's true cube pose (rehearsals that isolate the loop from perception)."""
+    """The simulator's true object poses (rehearsals that isolate the loop from perception).
+
+    The one source that knows every object of any task: the others perceive Block Grasp's cube only.
+    """
 
     def __init__(self, arm) -> None:
         self.arm = arm
 
     def read(self) -> PoseReading:
-        return PoseReading(T_base_cube=self.arm.true_cube_pose())
+        poses = self.arm.true_object_poses()
+        corrupted = poses.pop(self.arm.env.spec.corrupted_object)
+        return PoseReading(T_base_cube=corrupted, T_base_objects=poses)
 
 
 class FrankySimCubePose(PoseSource):
     """franky-sim's cube over its scene channel (a franky rehearsal's stand-in for the camera)."""
 
     def __init__(self, host: str, port: int) -> None:
-        from lerobot_robot_igen.backends.franky_sim_scene import FrankySimScene
+        from lerobot_robot_igen.arm.franky_sim_scene import FrankySimScene
 
         self.scene = FrankySimScene(host, port)
 

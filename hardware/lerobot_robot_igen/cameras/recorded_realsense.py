@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from lerobot.cameras.camera import Camera
 
-from lerobot_robot_igen.config_recorded_realsense import RecordedRealSenseConfig
+from lerobot_robot_igen.cameras.config_recorded_realsense import RecordedRealSenseConfig
 
 
 class RecordedRealSense(Camera):
@@ -25,12 +25,12 @@ class RecordedRealSense(Camera):
 
     @staticmethod
     def find_cameras() -> list[dict[str, Any]]:
-        from lerobot_robot_igen.realsense import connected_serials
+        from lerobot_robot_igen.cameras.realsense import connected_serials
 
         return [{"type": "igen_realsense", "id": serial} for serial in connected_serials()]
 
     def connect(self, warmup: bool = True) -> None:
-        from lerobot_robot_igen.realsense import CameraError, RealSenseConfig, RealSenseRGBD
+        from lerobot_robot_igen.cameras.realsense import CameraError, RealSenseConfig, RealSenseRGBD
 
         cfg = self.config
         rgbd = RealSenseRGBD(

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from igen_lerobot.core.exceptions import ConfigError
-from lerobot_robot_igen.pose_source import PoseReading
+from lerobot_robot_igen.perception.pose_source import PoseReading
 
 
 @dataclass

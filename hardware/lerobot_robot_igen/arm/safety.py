@@ -1,4 +1,4 @@
-"""The motion limits, checked in one place whatever drives the robot (see :class:`~lerobot_robot_igen.arm.SafeArm`).
+"""The motion limits, checked in one place whatever drives the robot (see ``SafeArm``).
 
 Limits live in the **task frame** (the frame the policy was trained in: Block Grasp's table top is
 at z = 0.8 m, the cube region centred on x = y = 0), so one set of numbers guards the simulated
@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.exceptions import ConfigError
+from lerobot_robot_igen.errors import HardwareError
 
 
-class SafetyViolationError(IgenError, RuntimeError):
+class SafetyViolationError(HardwareError):
     """A command would break a safety limit; the robot must stop."""
 
 

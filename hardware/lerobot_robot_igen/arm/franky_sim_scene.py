@@ -14,7 +14,7 @@ import socket
 import numpy as np
 
 from igen_lerobot.core.geometry import pos_quat_to_pose, quat_wxyz_to_xyzw
-from lerobot_robot_igen.driver import DriverError
+from lerobot_robot_igen.arm.driver import DriverError
 
 LIFT_SUCCESS = 0.04  # [m] as Block Grasp's success: the cube 4 cm above its resting height
 REST_Z = 0.025  # [m] the cube's centre at rest on franky-sim's floor (the table plane of the base frame)

@@ -1,4 +1,7 @@
-"""The simulated arm: the Block Grasp scene the policy was trained in, behind the driver protocol.
+"""The simulated arm: the scene of the task the policy was trained in, behind the driver protocol.
+
+Any registered task's scene (its env config, default Block Grasp's from LeRobot's env registry);
+6-DOF tasks' targets set the hand's orientation too, as their actions do in training.
 
 It is what a deployment is rehearsed on ("sim-to-sim"): the same loop, safety layer and
 perception code as on the real arm, with physics standing in for the robot. Time is simulated:
@@ -17,35 +20,47 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from lerobot_robot_igen.driver import ArmDriver, ArmState, ConnectionLostError
-from lerobot_robot_igen.safety import SafetyViolationError
+from igen_lerobot.core.actions import DeltaPoseActions
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, ConnectionLostError
+from lerobot_robot_igen.arm.safety import SafetyViolationError
 
 
 @dataclass
 class MujocoArmConfig:
-    """Scene settings; the cube region and control rate are Block Grasp's."""
+    """Scene settings: the control rate (the task's scene comes from its env config)."""
 
     fps: int = 20
     home_steps: int = 60  # control periods allowed for move_home
 
 
 class MujocoArm(ArmDriver):
-    """A Panda in the Block Grasp scene, commanded like the real arm (absolute targets, base frame)."""
+    """A Panda in a task's scene, commanded like the real arm (absolute targets, base frame)."""
 
-    def __init__(self, config: MujocoArmConfig | None = None) -> None:
+    DEFAULT_TASK = "block_grasp"
+
+    def __init__(self, config: MujocoArmConfig | None = None, env_config=None) -> None:
+        """``env_config``: the task's env config (a ``TaskEnvConfig``); None: Block Grasp's at ``config.fps``."""
         self.config = config or MujocoArmConfig()
+        self.env_config = env_config
         self.env = None
+        self._follows_rotation = False
         self._target_world: np.ndarray | None = None
         self._gripper_closed = False
         self._force = 0.0
 
     # ------------------------------------------------------------------ connection
     def connect(self) -> None:
-        from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
+        from igen_lerobot.core.env_config import task_config_class
 
         if self.env is None:
+            env_config = self.env_config or task_config_class(self.DEFAULT_TASK)(fps=self.config.fps)
+            if env_config.fps != self.config.fps:
+                raise ValueError(
+                    f"the task's scene runs at {env_config.fps} Hz, the simulated arm at {self.config.fps}"
+                )
             # built exactly as igen-eval builds it, so rehearsal trial i is igen-eval's scene i
-            self.env = BlockGraspEnvConfig(fps=self.config.fps).make_task_env()
+            self.env = env_config.make_task_env()
+            self._follows_rotation = isinstance(self.env.action_space, DeltaPoseActions)
             self.reset_scene(0)
             base = mujoco.mj_name2id(self.env.model, mujoco.mjtObj.mjOBJ_BODY, "robot0_base")
             self._world_from_base = np.eye(4)
@@ -73,19 +88,24 @@ class MujocoArm(ArmDriver):
 
     # ------------------------------------------------------------------ scene (simulation only)
     def reset_scene(self, seed: int) -> None:
-        """A new Block Grasp scene (cube position from ``seed``), arm at home, gripper open."""
+        """A new scene (objects placed from ``seed``), arm at home, gripper as the task starts it."""
         env = self._env()
         env.reset(seed)
         self._target_world = env.eef_pose()
-        self._gripper_closed = False
+        self._gripper_closed = env.arm.gripper_commanded_closed  # in-hand tasks start holding their part
         self._force = 0.0
 
+    def true_object_poses(self) -> dict[str, np.ndarray]:
+        """``T_base_<object>`` of every object: the simulator's ground truth, for truth-fed rehearsals."""
+        T_base_world = np.linalg.inv(self._world_from_base)
+        return {name: T_base_world @ T for name, T in self._env().true_object_poses().items()}
+
     def true_cube_pose(self) -> np.ndarray:
-        """``T_base_cube``: the simulator's ground truth, for judging and for truth-fed rehearsals."""
-        return np.linalg.inv(self._world_from_base) @ self._env().true_object_poses()["cube"]
+        """``T_base_cube`` (Block Grasp): the simulator's ground truth."""
+        return self.true_object_poses()["cube"]
 
     def task_success(self) -> bool:
-        """The task's own success test (cube between both pads, lifted 4 cm)."""
+        """The task's own success test (Block Grasp: cube between both pads, lifted 4 cm)."""
         return self._env().is_success()
 
     # ------------------------------------------------------------------ driver protocol
@@ -139,5 +159,6 @@ class MujocoArm(ArmDriver):
         env = self._env()
         if abs(period * self.config.fps - 1.0) > 1e-6:
             raise ValueError(f"the simulated arm steps 1/{self.config.fps} s per period, not {period} s")
-        env.step_to(self._target_world[:3, 3], self._gripper_closed, measure_force=True)
+        goal_rot = self._target_world[:3, :3] if self._follows_rotation else None  # else the task's fixed one
+        env.step_to(self._target_world[:3, 3], self._gripper_closed, measure_force=True, goal_rot=goal_rot)
         self._force = env.arm.peak_contact_force

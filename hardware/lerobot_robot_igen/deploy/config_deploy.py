@@ -20,9 +20,9 @@ from igen_lerobot.evaluation.config_eval import EVAL_SEED
 from igen_lerobot.training.policy_source import PolicySourceConfig
 from igen_lerobot.viz.rerun_log import RerunConfig
 from lerobot_env_igen.d415 import D415Noise
-from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
-from lerobot_robot_igen.pose_gate import PoseGateSettings
-from lerobot_robot_igen.safety import SafetyLimits
+from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
+from lerobot_robot_igen.arm.safety import SafetyLimits
+from lerobot_robot_igen.perception.pose_gate import PoseGateSettings
 
 
 @dataclass
@@ -81,8 +81,14 @@ HAND_ORIENTATIONS = ("goal", "measured")  # --hand_orientation
 
 @dataclass
 class DeployConfig:
-    """Run a trained Block Grasp policy on an arm at 20 Hz for N trials."""
+    """Run a trained policy on an arm at 20 Hz for N trials.
 
+    ``--task`` names the policy's task (LeRobot's ``--env.type``): its spec and action space shape
+    the observations and actions. Cameras perceive Block Grasp's cube only; other tasks rehearse on
+    the simulated arm with ``--perception.type=truth``.
+    """
+
+    task: str = "block_grasp"
     policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)  # --policy.path=.../pretrained_model
     robot: ArmBackendConfig = field(default_factory=SimArmBackendConfig)
     perception: PerceptionConfig = field(default_factory=RenderedPerceptionConfig)
@@ -110,7 +116,8 @@ class DeployConfig:
     output: str | None = None  # JSON file for the results
     rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log every step
     # What the policy is told the hand's orientation is. "goal": the task's fixed goal orientation,
-    # which its controller holds (position-only actions cannot change it); "measured": the arm's
+    # which its controller holds (position-only actions cannot change it; 6-DOF tasks have none and
+    # observe the measured one); "measured": the arm's
     # reading. The training arm's reading carries its own dynamic tilt (a few tenths of a degree
     # while it moves), which a policy can learn to read and no other arm reproduces
     # (docs/benchmarks.md: a constant 0.2 degree tilt took the Block Grasp checkpoint from 19/20 to 4/20).

@@ -3,14 +3,18 @@
 One loop for the real arm and for its rehearsal in simulation. Each period:
 
 1. read the arm (task frame) — a measured pose outside the workspace stops it;
-2. read the cube pose; the estimator may reject the frame, and the loop's
-   :class:`~lerobot_robot_igen.pose_gate.PoseGate` rejects low-confidence estimates and jumps
+2. read the pose of the object the task corrupts (Block Grasp's cube, Nut Insertion's peg) and,
+   from sources that know them (the simulator's truth), the other objects' poses; the estimator
+   may reject the frame, and the loop's
+   :class:`~lerobot_robot_igen.perception.pose_gate.PoseGate` rejects low-confidence estimates and jumps
    the cube could not have made; a rejected frame is bridged by the last accepted estimate for
    at most ``max_pose_age`` seconds, then the arm stops (stale perception). Every rejection is
    recorded with its reason (JSON report, Rerun);
 3. contact = external force above ``contact_force_threshold``; the first contact reveals the pose;
 4. build the observation exactly as in training and ask the policy for an action;
-5. send the target through :class:`~lerobot_robot_igen.arm.SafeArm` (limits, watchdog);
+5. turn the action into a target by the task's action layout (:mod:`~lerobot_robot_igen.deploy.actions`:
+   a position delta, a rotation for 6-DOF tasks, the gripper) and send it through
+   :class:`~lerobot_robot_igen.arm.safe_arm.SafeArm` (limits, watchdog);
 6. let the period pass (simulated arms step; real ones move while the loop sleeps).
 
 Any exception, Ctrl-C included, stops the arm before it propagates; faults end the episode
@@ -28,19 +32,21 @@ import numpy as np
 
 from igen_lerobot.core.agents import Policy, seed_policy
 from igen_lerobot.core.belief import ObjectBelief
+from igen_lerobot.core.env_config import TaskEnvConfig, task_config_class
 from igen_lerobot.core.exceptions import IgenError
 from igen_lerobot.core.observation import observation as build_observation
 from igen_lerobot.core.pacing import RatePacer
-from igen_lerobot.core.task import OBS_ENV_STATE, TaskSpec
-from lerobot_env_igen.block_grasp.spec import SPEC as BLOCK_GRASP_SPEC
-from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.driver import ArmState, DriverError
+from lerobot_robot_igen.arm.driver import ArmState
+from lerobot_robot_igen.arm.safe_arm import SafeArm
+from lerobot_robot_igen.arm.safety import SafetyViolationError
+from lerobot_robot_igen.deploy.actions import ActionLayout
 from lerobot_robot_igen.perception.cube_pose import PerceptionError
-from lerobot_robot_igen.pose_gate import PoseGate, PoseGateSettings
-from lerobot_robot_igen.pose_source import PoseReading, PoseSource
-from lerobot_robot_igen.safety import SafetyViolationError
+from lerobot_robot_igen.perception.pose_gate import PoseGate, PoseGateSettings
+from lerobot_robot_igen.perception.pose_source import PoseReading, PoseSource
 
 logger = logging.getLogger(__name__)
+
+DEFAULT_TASK = "block_grasp"  # what run_episode deploys when not told (found in LeRobot's env registry)
 
 
 class StalePerceptionError(PerceptionError):
@@ -124,15 +130,21 @@ def run_episode(
     settings: LoopSettings,
     judge: Callable[[ArmState, np.ndarray], bool],
     on_step: Callable[[StepRecord], None] | None = None,
-    spec: TaskSpec = BLOCK_GRASP_SPEC,
+    task: TaskEnvConfig | None = None,
     seed: int | None = None,
 ) -> EpisodeOutcome:
     """Run one episode; the arm is stopped (not disconnected) whatever happens.
 
-    ``belief`` is the core's belief about the cube (the same model the simulator keeps);
-    ``spec`` gives the observation layout the policy was trained on; ``seed`` (the trial's) fixes
-    the policy's sampling, as igen-eval's trial with that seed does.
+    ``belief`` is the core's belief about the corrupted object (the same model the simulator keeps);
+    ``task`` (its env config, default: Block Grasp's from the env registry) gives the observation
+    layout the policy was trained on and the action layout and action space that turn its action
+    into a target; ``seed`` (the trial's) fixes the policy's sampling, as igen-eval's trial with
+    that seed does.
     """
+    task = task if task is not None else task_config_class(DEFAULT_TASK)()
+    spec = task.task_spec
+    action_space = task.make_action_space()
+    layout = ActionLayout.of(spec.action_names)
     period = 1.0 / settings.fps
     max_stale = settings.max_pose_age
     pacer = RatePacer(settings.fps if settings.realtime else None)
@@ -142,7 +154,8 @@ def run_episode(
     arm.rearm()
     times: dict[str, list[float]] = {"perception": [], "policy": [], "command": [], "step": [], "period": []}
     outcome = EpisodeOutcome(success=False, steps=0)
-    T_world_cube: np.ndarray | None = None
+    T_world_cube: np.ndarray | None = None  # the corrupted object's pose (Block Grasp: the cube)
+    T_world_others: dict[str, np.ndarray] = {}  # the other objects' poses, from sources that know them
     pose_time = -np.inf  # loop time of the last good estimate
     gate = PoseGate(settings.pose_gate)
     gripper_closed = False
@@ -166,6 +179,7 @@ def run_episode(
                 rejection = gate.judge(reading, candidate, loop_time)
                 if rejection is None:
                     T_world_cube, pose_time, fresh = candidate, loop_time, True
+                    T_world_others = {name: arm.T_world_base @ T for name, T in reading.T_base_objects.items()}
             except PerceptionError as err:
                 rejection = ("estimator", str(err))
             if rejection is not None:
@@ -183,7 +197,8 @@ def run_episode(
             belief.update(felt, T_world_eef[:3, 3], T_world_cube)
             if belief.revealed and outcome.revealed_at is None:
                 outcome.revealed_at = step
-            believed = {spec.corrupted_object: belief.believed_pose(T_world_cube)}
+            believed = _believed_poses(spec, T_world_others)
+            believed[spec.corrupted_object] = belief.believed_pose(T_world_cube)
             T_observed = T_world_eef
             if settings.observed_hand_rotation is not None:
                 T_observed = T_world_eef.copy()
@@ -191,12 +206,21 @@ def run_episode(
             observation = build_observation(spec, T_observed, state.gripper_width, believed, belief)
 
             start = time.perf_counter()
-            action = np.asarray(policy.act(observation), dtype=float)
+            action = np.asarray(policy.act(observation), dtype=float).reshape(-1)
             times["policy"].append(time.perf_counter() - start)
 
             start = time.perf_counter()
-            gripper_closed = bool(action[3] > 0.0)
-            target = arm.command(T_world_eef, action[:3], close_gripper=gripper_closed, period=period)
+            if action.shape != (len(layout.names),):
+                raise SafetyViolationError(
+                    f"the policy's action has {action.size} values; task {spec.name!r} takes {len(layout.names)} "
+                    f"{layout.names}: is this checkpoint for this task?"
+                )
+            gripper_closed = layout.gripper_closed(action)
+            # 6-DOF tasks: the goal orientation the task's action space sets from the measured one
+            rotation = action_space.target_pose(T_world_eef, action)[:3, :3] if layout.rotates else None
+            target = arm.command(
+                T_world_eef, layout.delta(action), close_gripper=gripper_closed, period=period, rotation=rotation
+            )
             times["command"].append(time.perf_counter() - start)
             times["step"].append(time.perf_counter() - tick)
             if on_step is not None:
@@ -206,7 +230,7 @@ def run_episode(
                         state=state,
                         T_world_eef=T_world_eef,
                         T_world_cube=T_world_cube,
-                        believed_position=observation[OBS_ENV_STATE][:3].astype(float),
+                        believed_position=believed[spec.corrupted_object][:3, 3].copy(),
                         observation=observation,
                         action=action,
                         target=target,
@@ -223,7 +247,7 @@ def run_episode(
             if judge(state, action):
                 outcome.success = True
                 break
-    except (SafetyViolationError, PerceptionError, DriverError, IgenError) as err:
+    except IgenError as err:  # a HardwareError (driver, safety, perception) or another deliberate stop
         arm.halt(str(err))
         outcome.fault = arm.fault or str(err)
         logger.warning("episode stopped at step %d: %s", outcome.steps, outcome.fault)
@@ -235,6 +259,17 @@ def run_episode(
         outcome.timing = {name: timing_stats(values) for name, values in times.items()}
         outcome.clamped_targets = arm.clamped_targets
     return outcome
+
+
+def _believed_poses(spec, T_world_others: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The poses of the task's objects other than the corrupted one, or the reason the loop cannot go on."""
+    missing = [o for o in spec.objects if o != spec.corrupted_object and o not in T_world_others]
+    if missing:
+        raise PerceptionError(
+            f"task {spec.name!r} observes {spec.objects}; the pose source gives no pose of {missing} "
+            "(only the simulator's truth knows every object: --perception.type=truth)"
+        )
+    return {o: T_world_others[o] for o in spec.objects if o != spec.corrupted_object}
 
 
 def _count_rejection(outcome: EpisodeOutcome, step: int, kind: str, reason: str) -> None:

@@ -3,7 +3,7 @@
 LeRobot's own ``RealSenseCamera`` needs a connected camera's serial number; this one also plays a
 ``.db3`` recording, so robots, datasets and tests can run the real capture path without the
 device. LeRobot finds the camera class from this config's name (``RecordedRealSenseConfig`` ->
-``RecordedRealSense`` in ``lerobot_robot_igen.recorded_realsense``).
+``RecordedRealSense`` in ``lerobot_robot_igen.cameras.recorded_realsense``).
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """The arm as the deployment loop sees it: task-frame commands, every limit enforced here.
 
-:class:`SafeArm` wraps any :class:`~lerobot_robot_igen.driver.ArmDriver`. It converts between the
-task frame (where the policy acts, see :mod:`lerobot_robot_igen.safety`) and the robot base
-frame, refuses or limits commands with :class:`~lerobot_robot_igen.safety.SafetyGuard`, and runs
+:class:`SafeArm` wraps any :class:`~lerobot_robot_igen.arm.driver.ArmDriver`. It converts between the
+task frame (where the policy acts, see :mod:`lerobot_robot_igen.arm.safety`) and the robot base
+frame, refuses or limits commands with :class:`~lerobot_robot_igen.arm.safety.SafetyGuard`, and runs
 a watchdog thread that stops the arm when no command arrives for ``watchdog_timeout`` seconds
 of the arm's clock (wall time on a real arm, simulated time in a rehearsal), even if the loop
 itself hangs. Once stopped for a fault it refuses further commands until
@@ -16,8 +16,8 @@ import threading
 
 import numpy as np
 
-from lerobot_robot_igen.driver import ArmDriver, ArmState, DriverError
-from lerobot_robot_igen.safety import SafetyGuard, SafetyLimits, SafetyViolationError
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, DriverError
+from lerobot_robot_igen.arm.safety import SafetyGuard, SafetyLimits, SafetyViolationError
 
 logger = logging.getLogger(__name__)
 
@@ -80,12 +80,20 @@ class SafeArm:
         return self.T_base_world @ T_world
 
     # ------------------------------------------------------------------ commands
-    def command(self, T_world_eef: np.ndarray, delta: np.ndarray, close_gripper: bool, period: float) -> np.ndarray:
+    def command(
+        self,
+        T_world_eef: np.ndarray,
+        delta: np.ndarray,
+        close_gripper: bool,
+        period: float,
+        rotation: np.ndarray | None = None,
+    ) -> np.ndarray:
         """Move by ``delta`` [m, task frame] from ``T_world_eef`` this period; returns the sent task-frame target.
 
         The delta is clipped to ``max_delta`` per axis, as the simulator the policy was trained in
-        clips it. The target's orientation is ``goal_rotation`` when set (the training controller's
-        fixed goal), else the measured one. A delta beyond ``refuse_delta`` (no trained policy
+        clips it. The target's orientation is ``rotation`` (task frame) when given (a 6-DOF task's
+        action sets it), else ``goal_rotation`` when set (the training controller's fixed goal),
+        else the measured one. A delta beyond ``refuse_delta`` (no trained policy
         outputs that: a wrong checkpoint or normalisation), a non-finite one, or a target far
         outside the workspace stops the arm and raises :class:`SafetyViolationError`.
         """
@@ -95,6 +103,10 @@ class SafeArm:
         try:
             if delta.shape != (3,) or not np.all(np.isfinite(delta)):
                 raise SafetyViolationError(f"action delta {delta.tolist()} is not 3 finite values [m]")
+            if rotation is not None:
+                rotation = np.asarray(rotation, dtype=float)
+                if rotation.shape != (3, 3) or not np.all(np.isfinite(rotation)):
+                    raise SafetyViolationError(f"target orientation {rotation.tolist()} is not a finite 3x3 rotation")
             if np.any(np.abs(delta) > self.refuse_delta):
                 raise SafetyViolationError(
                     f"action delta {np.round(delta, 4).tolist()} m exceeds refuse_delta={self.refuse_delta} m per axis "
@@ -109,7 +121,9 @@ class SafeArm:
         if not np.allclose(np.clip(wanted, self.guard.limits.workspace_min, self.guard.limits.workspace_max), wanted):
             self.clamped_targets += 1
         target = np.array(T_world_eef, dtype=float)
-        if self.goal_rotation is not None:
+        if rotation is not None:
+            target[:3, :3] = rotation
+        elif self.goal_rotation is not None:
             target[:3, :3] = self.goal_rotation
         target[:3, 3] = target_pos
         try:

@@ -16,22 +16,25 @@ import time
 import numpy as np
 from tqdm import tqdm
 
+from igen_lerobot.core.actions import DeltaPositionActions
+from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import evaluate, wilson_interval
 from igen_lerobot.training.policy_source import make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
-from lerobot_robot_igen.arm import SafeArm
-from lerobot_robot_igen.belief import check_deployable, cube_belief
-from lerobot_robot_igen.config_deploy import (
+from lerobot_robot_igen.arm.driver import ArmDriver, ArmState, DriverError
+from lerobot_robot_igen.arm.safe_arm import SafeArm
+from lerobot_robot_igen.deploy.actions import ActionLayout
+from lerobot_robot_igen.deploy.belief import check_deployable, cube_belief
+from lerobot_robot_igen.deploy.config_deploy import (
     DeployConfig,
     FrankySimPerceptionConfig,
     RealSensePerceptionConfig,
     RenderedPerceptionConfig,
     TruthPerceptionConfig,
 )
-from lerobot_robot_igen.deploy_loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
-from lerobot_robot_igen.driver import ArmDriver, ArmState, DriverError
-from lerobot_robot_igen.pose_source import PoseSource
+from lerobot_robot_igen.deploy.loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
+from lerobot_robot_igen.perception.pose_source import PoseSource
 
 logger = logging.getLogger(__name__)
 
@@ -47,12 +50,14 @@ class GraspLiftJudge:
     (A rehearsal uses the simulator's own success test instead.)
     """
 
-    def __init__(self, cube_size: float = 0.05, lift: float = 0.04) -> None:
+    def __init__(self, cube_size: float = 0.05, lift: float = 0.04, layout: ActionLayout | None = None) -> None:
+        """``layout``: where the action keeps the gripper (default: Block Grasp's actions)."""
         self.cube_size, self.lift = cube_size, lift
+        self.layout = layout or ActionLayout.of(task_config_class("block_grasp")().task_spec.action_names)
         self._grasp_z: float | None = None
 
     def __call__(self, state: ArmState, action: np.ndarray) -> bool:
-        closed = bool(action[3] > 0.0)
+        closed = self.layout.gripper_closed(action)
         holding = closed and holds_cube(state.gripper_width, self.cube_size)
         if not holding:
             self._grasp_z = None
@@ -65,7 +70,7 @@ class GraspLiftJudge:
 
 def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
     """The configured cube pose source (sim sources need the simulated arm)."""
-    from lerobot_robot_igen import pose_source
+    from lerobot_robot_igen.perception import pose_source
 
     p = cfg.perception
     if isinstance(p, TruthPerceptionConfig):
@@ -75,8 +80,8 @@ def make_pose_source(cfg: DeployConfig, driver: ArmDriver) -> PoseSource:
     if isinstance(p, RenderedPerceptionConfig):
         return pose_source.RenderedICPPose(driver, p.distance, p.azimuth_deg, p.elevation_deg, p.noise)
     if isinstance(p, RealSensePerceptionConfig):
+        from lerobot_robot_igen.cameras.realsense import RealSenseConfig, RealSenseRGBD
         from lerobot_robot_igen.perception.camera_model import load_extrinsics
-        from lerobot_robot_igen.realsense import RealSenseConfig, RealSenseRGBD
 
         T_base_camera = load_extrinsics(p.calibration)
         camera = RealSenseRGBD(RealSenseConfig(serial=p.serial, recording=p.recording))
@@ -102,8 +107,8 @@ def _summary(name: str, outcomes: list[EpisodeOutcome]) -> dict:
     }
 
 
-def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray) -> LoopSettings:
-    """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame)."""
+def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray | None) -> LoopSettings:
+    """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame; None: 6-DOF)."""
     return LoopSettings(
         fps=cfg.fps,
         max_steps=cfg.max_steps,
@@ -111,16 +116,14 @@ def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray) -> LoopSettings:
         max_pose_age=cfg.max_pose_age,
         realtime=bool(cfg.realtime),
         pose_gate=cfg.pose_gate,
-        observed_hand_rotation=goal_rotation if cfg.hand_orientation == "goal" else None,
+        observed_hand_rotation=goal_rotation if cfg.hand_orientation == "goal" else None,  # None: measured
     )
 
 
 def deploy(cfg: DeployConfig, on_step=None) -> dict:
     """Run ``cfg.trials`` episodes; returns (and optionally writes) a JSON-able report."""
-    from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
-
-    env_cfg = BlockGraspEnvConfig()
-    check_deployable(env_cfg.task_spec)
+    env_cfg = task_config_class(cfg.task)()  # the task from LeRobot's env registry, as igen-eval finds it
+    check_deployable(env_cfg.task_spec, truth=isinstance(cfg.perception, TruthPerceptionConfig))
     import torch
 
     torch.set_num_threads(cfg.inference_threads)
@@ -135,13 +138,15 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         finally:
             env.close()
     situations = _trial_situations(env_cfg, cfg) if isinstance(cfg.perception, FrankySimPerceptionConfig) else None
-    driver = cfg.robot.make_driver()
+    driver = cfg.robot.make_driver(env_cfg)
     driver.connect()
     simulated = cfg.robot.simulated
     world_from_base = driver.world_from_base if driver.world_from_base is not None else cfg.real_world_from_base()
     # targets keep the task's goal orientation, as its training controller's goal did: the policy saw
-    # that orientation held within a fraction of a degree, and reads a drifted one as a new situation
-    goal_rotation = env_cfg.make_action_space().rotation
+    # that orientation held within a fraction of a degree, and reads a drifted one as a new situation.
+    # A 6-DOF task has none: its actions turn the hand
+    action_space = env_cfg.make_action_space()
+    goal_rotation = action_space.rotation if isinstance(action_space, DeltaPositionActions) else None
     arm = SafeArm(driver, world_from_base, cfg.safety, goal_rotation=goal_rotation)
     try:
         poses = make_pose_source(cfg, driver)
@@ -183,7 +188,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
                     stopped = {"before_trial": i, "reason": str(err)}
                     break
                 belief = cube_belief(offset, cfg.reveal)
-                outcome = run_episode(arm, poses, policy, belief, settings, judge, record, env_cfg.task_spec, seed)
+                outcome = run_episode(arm, poses, policy, belief, settings, judge, record, env_cfg, seed)
                 outcomes.append(outcome)
                 if not simulated:
                     driver.set_gripper(False)
@@ -279,7 +284,7 @@ def _trial_situations(env_cfg, cfg: DeployConfig) -> list[tuple[np.ndarray, np.n
 def _franky_sim_trial(driver, scene, situation, world_from_base: np.ndarray):
     """One igen-eval trial on franky-sim: the arm home, the cube where the trial has it; its pose error and judge."""
     from lerobot_env_igen.block_grasp.spec import CUBE_HALF
-    from lerobot_robot_igen.backends.franky_sim_scene import LIFT_SUCCESS
+    from lerobot_robot_igen.arm.franky_sim_scene import LIFT_SUCCESS
 
     T_world_cube, corruption = situation
     driver.move_home()

@@ -11,7 +11,7 @@ Absolute targets make LeRobot's tear-down safe: ``lerobot-rollout`` returns the 
 initial position by sending interpolated ``*.pos`` values of the *observation*; the position
 and gripper keys are targets like any other, and the quaternion keys (not actions: the arm holds
 its orientation) are ignored. Any other key is refused with the list of what the robot takes.
-Every target goes through :class:`~lerobot_robot_igen.arm.SafeArm`: a far target is approached
+Every target goes through :class:`~lerobot_robot_igen.arm.safe_arm.SafeArm`: a far target is approached
 at ``max_step`` per action and the speed limit, never jumped to.
 """
 
@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from lerobot.robots.robot import Robot
 
-from lerobot_robot_igen.config_igen_franka import IgenFrankaConfig
+from lerobot_robot_igen.robots.config_igen_franka import IgenFrankaConfig
 
 logger = logging.getLogger(__name__)
 
@@ -78,7 +78,7 @@ class IgenFranka(Robot):
     def connect(self, calibrate: bool = True) -> None:
         from lerobot.cameras import make_cameras_from_configs
 
-        from lerobot_robot_igen.arm import SafeArm
+        from lerobot_robot_igen.arm.safe_arm import SafeArm
 
         if self.is_connected:
             raise RuntimeError(f"{self} is already connected")

@@ -1,4 +1,4 @@
-r"""Deploy a trained Block Grasp policy at 20 Hz: on a real Franka, or rehearsed in simulation.
+r"""Deploy a trained policy at 20 Hz: on a real Franka (Block Grasp), or rehearsed in simulation (any task).
 
 Examples::
 
@@ -11,6 +11,9 @@ Examples::
     igen-deploy --policy.path=... --robot.type=franky --robot.host=172.16.0.2 \
         --perception.type=realsense --perception.calibration=calib/T_base_camera.json --trials=10
 
+    # another task's policy (7-D actions), rehearsed on the MuJoCo arm with the simulator's poses
+    igen-deploy --task=nut_insertion --robot.type=sim --perception.type=truth --trials=10
+
 """
 
 import json
@@ -18,8 +21,8 @@ import logging
 from pathlib import Path
 
 from igen_lerobot.scripts.cli import run_cli
-from lerobot_robot_igen.config_deploy import DeployConfig
-from lerobot_robot_igen.deploy import deploy
+from lerobot_robot_igen.deploy.config_deploy import DeployConfig
+from lerobot_robot_igen.deploy.trials import deploy
 
 logger = logging.getLogger(__name__)
 

@@ -1,6 +1,6 @@
-"""What the deployed robot believes about the cube: the core's belief model, fed from perception.
+"""What the deployed robot believes about the corrupted object: the core's belief model, fed from perception.
 
-The policy was trained on Block Grasp observations, built by
+The policy was trained on its task's observations (Block Grasp: about the cube), built by
 :func:`igen_lerobot.core.observation.observation` from the end-effector pose, the gripper width,
 the cube pose *as the robot believes it* and the belief's contact/revealed values. The deployment
 keeps the same :class:`~igen_lerobot.core.belief.ObjectBelief` the simulator keeps: the perceived
@@ -22,15 +22,23 @@ DEPLOYED_OBJECT = "cube"
 
 
 def cube_belief(offset: np.ndarray, reveal: Reveal) -> ObjectBelief:
-    """A fresh belief for one episode: the cube is believed ``offset`` [m] away until it is touched."""
+    """A fresh belief for one episode: the corrupted object is believed ``offset`` [m] away until touched."""
     # any position-offset model applies a sample the same way; its bounds play no part here
     return ObjectBelief(BoxNoise(), np.asarray(offset, dtype=float).reshape(3), Reveal(reveal))
 
 
-def check_deployable(spec: TaskSpec) -> None:
-    """The deployment perceives one cube and feels contacts with it; refuse a task of another shape."""
+def check_deployable(spec: TaskSpec, truth: bool = False) -> None:
+    """Refuse a task the configured perception cannot see.
+
+    The cameras (RealSense, rendered D415, franky-sim's scene channel) perceive one cube and the arm
+    feels contacts with it, so they deploy Block Grasp only. ``truth`` (the simulator's poses, a
+    rehearsal) knows every object of any task.
+    """
+    if truth:
+        return
     if spec.objects != (DEPLOYED_OBJECT,) or spec.reveal_contact != ("gripper", DEPLOYED_OBJECT):
         raise ConfigError(
-            f"igen-deploy perceives a single cube and reveals on gripper-cube contact; task {spec.name!r} has "
-            f"objects {spec.objects} revealed on {spec.reveal_contact}: deploy a Block Grasp policy"
+            f"igen-deploy's cameras perceive a single cube and reveal on gripper-cube contact; task {spec.name!r} has "
+            f"objects {spec.objects} revealed on {spec.reveal_contact}: deploy a Block Grasp policy, or rehearse "
+            "this task with --robot.type=sim --perception.type=truth"
         )

@@ -17,7 +17,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from lerobot_robot_igen.backends.training_controller import TrainingController
+from lerobot_robot_igen.arm.training_controller import TrainingController
 
 logger = logging.getLogger(__name__)
 

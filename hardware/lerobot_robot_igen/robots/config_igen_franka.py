@@ -1,7 +1,7 @@
 """LeRobot config of our Franka (``--robot.type=igen_franka``): LeRobot 0.6 ships no Franka.
 
 LeRobot finds the robot class from this config's name (``IgenFrankaConfig`` -> ``IgenFranka`` in
-``lerobot_robot_igen.igen_franka``), after importing the ``lerobot_robot_igen`` plugin.
+``lerobot_robot_igen.robots.igen_franka``), after importing the ``lerobot_robot_igen`` plugin.
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ from lerobot.cameras import CameraConfig
 from lerobot.robots.config import RobotConfig
 
 from igen_lerobot.core.exceptions import ConfigError
-from lerobot_robot_igen.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
-from lerobot_robot_igen.config_end_effector_target import HOME_TARGET
-from lerobot_robot_igen.safety import SafetyLimits
+from lerobot_robot_igen.arm.config_arm import REAL_WORLD_FROM_BASE_XYZ, ArmBackendConfig, SimArmBackendConfig
+from lerobot_robot_igen.arm.safety import SafetyLimits
+from lerobot_robot_igen.teleoperators.config_end_effector_target import HOME_TARGET
 
 
 @RobotConfig.register_subclass("igen_franka")

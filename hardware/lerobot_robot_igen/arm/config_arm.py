@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import draccus
 
-from lerobot_robot_igen.driver import ArmDriver
+from lerobot_robot_igen.arm.driver import ArmDriver
 
 # Where a real, table-mounted arm's base sits in the task frame: the table top is z = 0.8 m in
 # training, and the cube region is centred 0.56 m in front of the base, as in the simulator.
@@ -27,14 +27,14 @@ class ArmBackendConfig(draccus.ChoiceRegistry, abc.ABC):
         return False
 
     @abc.abstractmethod
-    def make_driver(self) -> ArmDriver:
-        """The (not yet connected) driver."""
+    def make_driver(self, env_config=None) -> ArmDriver:
+        """The (not yet connected) driver; a simulated arm builds ``env_config``'s task scene, a real one ignores it."""
 
 
 @ArmBackendConfig.register_subclass("sim")
 @dataclass
 class SimArmBackendConfig(ArmBackendConfig):
-    """The Block Grasp scene in MuJoCo (rehearsal)."""
+    """The task's scene in MuJoCo (rehearsal; Block Grasp unless igen-deploy's --task says otherwise)."""
 
     fps: int = 20
 
@@ -42,11 +42,11 @@ class SimArmBackendConfig(ArmBackendConfig):
     def simulated(self) -> bool:
         return True
 
-    def make_driver(self) -> ArmDriver:
-        from lerobot_robot_igen.backends.mujoco_arm import MujocoArm, MujocoArmConfig
+    def make_driver(self, env_config=None) -> ArmDriver:
+        from dataclasses import replace
 
-        return MujocoArm(MujocoArmConfig(fps=self.fps))
+        from lerobot_robot_igen.arm.mujoco_arm import MujocoArm, MujocoArmConfig
 
-
-# Registers --robot.type=franky (its module imports franky only when a driver connects).
-from lerobot_robot_igen.backends import franky_arm as _franky_arm  # noqa: E402, F401
+        if env_config is not None:
+            env_config = replace(env_config, fps=self.fps)
+        return MujocoArm(MujocoArmConfig(fps=self.fps), env_config)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from lerobot.teleoperators.config import TeleoperatorConfig
 
 from igen_lerobot.core.exceptions import ConfigError
-from lerobot_robot_igen.safety import SafetyLimits
+from lerobot_robot_igen.arm.safety import SafetyLimits
 
 HOME_TARGET = (-0.05, 0.0, 1.0)  # [m] task frame: Block Grasp's start pose, where igen_franka homes to
 

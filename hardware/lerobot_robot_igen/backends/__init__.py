@@ -1,1 +1,0 @@
-"""Arm driver backends: each imports its robot library only when built."""

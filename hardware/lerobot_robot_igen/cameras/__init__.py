@@ -1,0 +1,1 @@
+"""Cameras: RealSense capture and the ``recorded_realsense`` LeRobot camera (``--robot.cameras``)."""

@@ -1,0 +1,1 @@
+"""The ``igen_franka`` LeRobot robot (``--robot.type=igen_franka``)."""
