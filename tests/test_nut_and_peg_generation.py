@@ -98,3 +98,28 @@ def test_mimicgen_demonstrations_on_geometry_1_succeed(data):
     for ep in episodes:
         assert ep.kind == EpisodeKind.MIMICGEN and ep.success and not ep.is_intervention.any()
         assert ep.subtask[0] == 0 and np.all(np.diff(ep.subtask) >= 0) and ep.subtask[-1] == 1  # grasp, then place
+
+
+def test_the_recording_shows_the_missed_grasp_and_the_regrasp(data, tmp_path):
+    """igen-viz of the generated episode, read back with Rerun's reader: flag and subtask plots, events."""
+    from test_viz import column, read_rrd
+
+    from lerobot_env_igen.nut_and_peg.spec import EMPTY_WIDTH, HELD_WIDTH
+
+    out = tmp_path / "igen.rrd"
+    ok(run_here("igen-viz", f"--dataset.root={data / 'igen'}", f"--output={out}"))
+    chunks = read_rrd(out)
+    spec = dataset_spec(data / "igen")
+    (ep,) = load_episodes(data / "igen", spec)
+    root = "/episodes/0"
+    flag = np.array(column(chunks[f"{root}/flag"], "Scalars:scalars")).reshape(-1)
+    subtask = np.array(column(chunks[f"{root}/subtask"], "Scalars:scalars")).reshape(-1)
+    np.testing.assert_array_equal(flag, ep.is_intervention.astype(float))
+    np.testing.assert_array_equal(subtask, ep.subtask.astype(float))
+    events = [text for row in column(chunks[f"{root}/events"], "TextLog:text") for text in row]
+    takeover, subtask_change, hand_back, end = events
+    mm = [float(e.split("gripper ")[1].split(" mm")[0]) / 1000 for e in (takeover, subtask_change, hand_back)]
+    assert takeover.startswith("takeover") and mm[0] < EMPTY_WIDTH  # the missed grasp: closed on air
+    assert subtask_change.startswith("subtask 0 -> 1 (place)")  # the regrasp
+    assert hand_back.startswith("hand-back") and HELD_WIDTH[0] <= mm[2] <= HELD_WIDTH[1]  # holding the nut
+    assert end == "end: success"
