@@ -14,8 +14,12 @@ Examples::
     MUJOCO_GL=egl .venv/bin/python benchmarks/check_task_identity.py record /tmp/ref
     MUJOCO_GL=egl .venv/bin/python benchmarks/check_task_identity.py record /tmp/new
     .venv/bin/python benchmarks/check_task_identity.py compare /tmp/ref /tmp/new
+    # other tasks (any registered Panda task; default: block_grasp nut_insertion nut_insertion_contact_position)
+    MUJOCO_GL=egl .venv/bin/python benchmarks/check_task_identity.py record /tmp/ref \
+        --tasks block_grasp nut_insertion two_piece_assembly coffee
 
-Small on purpose (3-4 episodes per dataset, one worker): about 5 minutes on 2 busy cores.
+Small on purpose (3-4 episodes per dataset, one worker): about 5 minutes on 2 busy cores for the default
+three.
 """
 
 from __future__ import annotations
@@ -29,11 +33,9 @@ from pathlib import Path
 import numpy as np
 
 BIN = Path(sys.executable).parent
-TASKS = {
-    "block_grasp": [],
-    "nut_insertion": [],
-    "nut_insertion_contact_position": ["--env.reveal=contact_position"],
-}
+# a name ending in _contact_position runs its task under --env.reveal=contact_position
+DEFAULT_TASKS = ("block_grasp", "nut_insertion", "nut_insertion_contact_position")
+CONTACT_POSITION = "_contact_position"
 COLLECT = {"demos": 4, "interventions": 4}
 GENERATE = {"mimicgen": ("demos", 3), "igen_no_policy": ("interventions", 3), "igen": ("interventions", 3)}
 TRACE_SEEDS = (0, 1, 7, 123, 2024)
@@ -45,10 +47,11 @@ def _run(cmd: list[str]) -> None:
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
 
 
-def record(out: Path) -> None:
+def record(out: Path, tasks: tuple[str, ...] = DEFAULT_TASKS) -> None:
     out.mkdir(parents=True, exist_ok=False)
-    for name, flags in TASKS.items():
-        env = ["--env.type=" + name.removesuffix("_contact_position"), *flags]
+    for name in tasks:
+        flags = ["--env.reveal=contact_position"] if name.endswith(CONTACT_POSITION) else []
+        env = ["--env.type=" + name.removesuffix(CONTACT_POSITION), *flags]
         for mode, n in COLLECT.items():
             root = out / name / mode
             _run([str(BIN / "igen-collect"), *env, f"--mode={mode}", f"--num_episodes={n}", "--seed=5",
@@ -57,7 +60,7 @@ def record(out: Path) -> None:
             root = out / name / mode
             _run([str(BIN / "igen-generate"), *env, f"--mode={mode}", f"--source.root={out / name / source}",
                   f"--num_episodes={n}", "--seed=11", "--workers=1", f"--dataset.root={root}"])  # fmt: skip
-        trace(name.removesuffix("_contact_position"), flags, out / name / "trace.npz")
+        trace(name.removesuffix(CONTACT_POSITION), flags, out / name / "trace.npz")
 
 
 def trace(task: str, flags: list[str], path: Path) -> None:
@@ -173,13 +176,15 @@ def _strip_paths(value, root: Path):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
-    sub.add_parser("record").add_argument("out", type=Path)
+    record_parser = sub.add_parser("record")
+    record_parser.add_argument("out", type=Path)
+    record_parser.add_argument("--tasks", nargs="+", default=list(DEFAULT_TASKS), help="task names (env types)")
     cmp_parser = sub.add_parser("compare")
     cmp_parser.add_argument("ref", type=Path)
     cmp_parser.add_argument("new", type=Path)
     args = parser.parse_args()
     if args.command == "record":
-        record(args.out)
+        record(args.out, tuple(args.tasks))
     else:
         raise SystemExit(compare(args.ref, args.new))
 

@@ -260,6 +260,42 @@ class TaskEnv(abc.ABC):
         """
         return None
 
+    def mistake_possible(self, subtask: int) -> bool:
+        """Whether the task's mistake signal can fire in ``subtask``.
+
+        IntervenGen forces a recovery on a policy that ran its mistake budget without a detected
+        mistake only where one could have been detected; elsewhere (Nut-and-Peg's place subtask:
+        nothing there is misperceived) the policy runs on to success, the next subtask or the
+        attempt's step limit. Default: every subtask.
+        """
+        return True
+
+    def recovery_done(self, subtask: int) -> bool:
+        """Whether a replayed recovery of ``subtask`` may hand control back to the policy now.
+
+        Asked while the recovery holds its last goal, after its recorded frames. Default: once the
+        subtask is done. A task whose policy needs more (Nut-and-Peg: a grasp settled for a few
+        steps, not the first touch of the pads) says so here.
+        """
+        return self.subtask_index() > subtask
+
+    def replay_goals(
+        self,
+        goals: np.ndarray,
+        subtask: int,
+        T_src_world_objects: dict[str, np.ndarray],
+        T_src_world_eef: np.ndarray,
+    ) -> np.ndarray:
+        """A source segment's end-effector goals, already moved into this scene, as the task replays them.
+
+        ``goals`` (N, 4, 4); ``T_src_world_objects`` and ``T_src_world_eef`` are the source's true
+        object poses and end effector at the segment's first frame. Default: unchanged. A task
+        whose hand is symmetric under a half turn (a parallel gripper) may take the equivalent
+        goals that start nearer the hand, or that keep a held object on the source's side of it
+        (Nut-and-Peg).
+        """
+        return goals
+
     def action_towards(self, T_world_eef_target: np.ndarray, gripper_closed: bool) -> np.ndarray:
         """The action that drives the end effector towards a target pose in one step."""
         return self.action_space.action_towards(self.eef_pose(), T_world_eef_target, gripper_closed)

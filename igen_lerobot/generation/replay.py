@@ -94,10 +94,12 @@ def replay_segment(
 
     Stops early on task success, on ``max_steps``, or (``stop_on_mistake``) on the task's mistake
     signal (used when a replayed mistake stands in for the policy). The hold after the segment
-    ends as soon as the segment's subtask is done.
+    ends as soon as the segment's subtask is done; for a recovery (``flagged``), as soon as the
+    task says it may hand control back (:meth:`~igen_lerobot.core.task.TaskEnv.recovery_done`).
     """
     T_world_obj = env.true_object_poses()[segment.object_name]
     transformed = transform_segment(segment.targets, segment.T_world_obj, T_world_obj)
+    transformed = env.replay_goals(transformed, segment.subtask, segment.T_world_objects, segment.eef[0])
     T_world_eef = env.eef_pose()
     distance = float(np.linalg.norm(transformed[0][:3, 3] - T_world_eef[:3, 3]))
     angle = rotation_angle(T_world_eef[:3, :3], transformed[0][:3, :3])
@@ -118,8 +120,10 @@ def replay_segment(
     for index, (goal, closed, source) in enumerate(zip(goals, gripper, sources, strict=True)):
         if steps >= max_steps:
             break
-        if index >= holding_from and env.subtask_index() > segment.subtask:
-            break  # the subtask is done: go on with the next one instead of idling
+        if index >= holding_from and (
+            env.recovery_done(segment.subtask) if flagged else env.subtask_index() > segment.subtask
+        ):
+            break  # the subtask is done (a recovery: the task hands back): go on instead of idling
         action = env.action_towards(cfg.perturb(goal, rng), bool(closed))
         recorder.record(obs, action, source, flagged)
         info = env.step(action)

@@ -42,6 +42,7 @@ class SourceSegment:
     gripper_closed: np.ndarray  # (N,) bool
     corruption: np.ndarray  # the source episode's pose error
     source_seed: int = 0
+    T_world_objects: dict[str, np.ndarray] = field(default_factory=dict)  # every object's true pose at the first frame
 
     @property
     def length(self) -> int:
@@ -114,6 +115,7 @@ def _segment(
         gripper_closed=np.array([gripper_from_action(a) for a in actions]),
         corruption=np.asarray(ep.corruption, dtype=float),
         source_seed=ep.seed,
+        T_world_objects={name: spec.object_poses(ep.true_object_pose[rows.start], name) for name in spec.objects},
     )
 
 

@@ -107,8 +107,15 @@ class EpisodeLogger:
         kind: str = "",
         source_paths: dict[int, np.ndarray] | None = None,
         corruption: np.ndarray | None = None,
+        subtask: np.ndarray | None = None,
     ) -> None:
-        """One whole episode (arrays as in the dataset schema), sent column-wise on the ``frame`` timeline."""
+        """One whole episode (arrays as in the dataset schema), sent column-wise on the ``frame`` timeline.
+
+        Per frame: the path coloured by phase, object boxes, actions, the gripper opening [m], the
+        intervention flag (``flag``: 0/1) and, given ``subtask``, the subtask index; ``events``
+        lists each takeover, hand-back and subtask change with the gripper opening there (a missed
+        grasp shows as a takeover with the fingers closed, a regrasp as a hand-back holding).
+        """
         rr, stream = self.rr, self.stream
         root = f"episodes/{index}"
         n = len(state)
@@ -155,10 +162,16 @@ class EpisodeLogger:
             stream.send_columns(
                 f"{root}/action/{name}", indexes=[frames], columns=rr.Scalars.columns(scalars=action[:, j])
             )
-        stream.send_columns(
-            f"{root}/gripper", indexes=[frames], columns=rr.Scalars.columns(scalars=np.asarray(state)[:, -1])
-        )
-        self._events(root, phases, revealed, success, n)
+        width = np.asarray(state, dtype=float)[:, -1]
+        stream.send_columns(f"{root}/gripper", indexes=[frames], columns=rr.Scalars.columns(scalars=width))
+        flags = np.asarray(flagged, dtype=bool).reshape(-1)
+        stream.send_columns(f"{root}/flag", indexes=[frames], columns=rr.Scalars.columns(scalars=flags.astype(float)))
+        if subtask is not None:
+            subtask = np.asarray(subtask, dtype=int).reshape(-1)
+            stream.send_columns(
+                f"{root}/subtask", indexes=[frames], columns=rr.Scalars.columns(scalars=subtask.astype(float))
+            )
+        self._events(root, phases, revealed, success, n, flags, width, subtask)
         for source_index, path in (source_paths or {}).items():
             stream.log(
                 f"sources/{source_index}/recovery",
@@ -192,17 +205,39 @@ class EpisodeLogger:
             colors=np.tile(color, (n, 1)),
         )
 
-    def _events(self, root: str, phases: np.ndarray, revealed: np.ndarray, success: bool, n: int) -> None:
+    def _events(
+        self,
+        root: str,
+        phases: np.ndarray,
+        revealed: np.ndarray,
+        success: bool,
+        n: int,
+        flags: np.ndarray,
+        width: np.ndarray,
+        subtask: np.ndarray | None,
+    ) -> None:
         rr, stream = self.rr, self.stream
         events: list[tuple[int, str]] = []
+
+        def gripper(t: int) -> str:
+            return f"(gripper {1000 * width[t]:.0f} mm)"
+
         revealed = np.flatnonzero(revealed)
         if len(revealed):
             events.append((int(revealed[0]), "first contact: the true pose is revealed"))
-        recovery = np.flatnonzero(np.isin(phases, [Phase.OPERATOR, Phase.GENERATED, Phase.INTERPOLATION]))
-        if len(recovery):
-            events.append((int(recovery[0]), "takeover: recovery starts"))
-        events.append((n - 1, "end: success" if success else "end: failure"))
+        recovery = np.isin(phases, [Phase.OPERATOR, Phase.GENERATED, Phase.INTERPOLATION]) & flags
+        for t in np.flatnonzero(np.diff(recovery.astype(int), prepend=0) == 1):
+            events.append((int(t), f"takeover: recovery starts {gripper(int(t))}"))
+        for t in np.flatnonzero(np.diff(recovery.astype(int)) == -1) + 1:
+            events.append((int(t), f"hand-back: the policy resumes {gripper(int(t))}"))
+        if subtask is not None:
+            names = [s.name for s in self.spec.subtasks]
+            for t in np.flatnonzero(np.diff(subtask)) + 1:
+                a, b = (int(subtask[t - 1]), int(subtask[t]))
+                name = names[b] if 0 <= b < len(names) else "done"
+                events.append((int(t), f"subtask {a} -> {b} ({name}) {gripper(int(t))}"))
         events.sort()
+        events.append((n - 1, "end: success" if success else "end: failure"))
         stream.send_columns(
             f"{root}/events",
             indexes=[rr.TimeColumn(FRAME, sequence=[t for t, _ in events])],
@@ -223,6 +258,7 @@ class EpisodeLogger:
             kind=episode.kind,
             source_paths=source_paths,
             corruption=episode.corruption,
+            subtask=episode.subtask,
         )
 
     def log_outcome(self, index: int | str, success: bool, reason: str = "") -> None:

@@ -14,6 +14,14 @@ nothing reveals it. 6-DOF delta-pose actions at 20 Hz, 400 steps.
 * Subtask progress: 0 while the nut lies on the table, 1 once both finger pads hold it and while it
   is held, in the air or on the peg (dropped back on the table: 0, to be grasped again), 2 on success.
 * Success: robosuite's ``on_peg`` **and released** (no finger touches the nut).
+* Generation: a replayed segment's hand goals may be turned half a turn about the approach axis
+  (the parallel gripper's symmetry, which the scripted rule uses to keep its yaw in (-pi/2, pi/2]):
+  a grasp segment starts the way nearer the hand (not a half turn of the wrist beside the nut), a
+  place segment keeps the held nut on the side of the hand it was on in the source.
+  A mistake can happen only in the grasp subtask (the peg's pose is exact); a replayed
+  grasp recovery hands control back once both pads have held the nut for ``HAND_BACK_HELD_STEPS``
+  consecutive steps, a settled grasp the policy recognises by the opening (at the first touch the
+  fingers are still closing, and the policy, believing the handle elsewhere, would open them).
 """
 
 from __future__ import annotations
@@ -22,6 +30,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from igen_lerobot.core.geometry import rot_z, rotation_angle
+from igen_lerobot.core.task import StepInfo
 from lerobot_env_igen.nut_and_peg.spec import EMPTY_WIDTH, NUT_REGION_CENTER, PEG_XY
 from lerobot_env_igen.panda import TOP_DOWN_ROT
 from lerobot_env_igen.panda_spec import GRIPPER, TABLE_TOP_Z
@@ -34,6 +44,9 @@ if TYPE_CHECKING:
 HOME_EEF_POS = (NUT_REGION_CENTER[0], NUT_REGION_CENTER[1] - 0.05, 1.0)  # [m] 19 cm above the nut region
 LIFTED = 0.01  # [m] the nut's centre this far above its resting height is off the table
 SETTLE_STEPS = 2  # control periods the dropped-in nut gets to come to rest at reset
+HAND_BACK_HELD_STEPS = 3  # a grasp recovery hands back once both pads held the nut this many steps in a row
+GRASP = 0  # the grasp subtask's index
+HALF_TURN = rot_z(np.pi)  # about the hand's approach axis (its z axis, pointing down)
 
 
 class NutAndPegEnv(PandaTaskEnv):
@@ -43,6 +56,7 @@ class NutAndPegEnv(PandaTaskEnv):
         super().__init__(config, objects=[square_nut(), square_peg()], home_pos=HOME_EEF_POS)
         self.nut_region = config.region()
         self._closed_on_air = False
+        self._held_steps = 0  # consecutive steps with the nut between both pads
 
     def place(self, rng: np.random.Generator) -> None:
         xy = self.nut_region.sample(rng)
@@ -51,6 +65,7 @@ class NutAndPegEnv(PandaTaskEnv):
         self.set_free_pose("nut", (xy[0], xy[1], nut_z), (np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)))
         self.set_fixed_pose("peg", (PEG_XY[0], PEG_XY[1], PEG_CENTER_Z))
         self._closed_on_air = False
+        self._held_steps = 0
 
     def settle(self) -> None:
         home = self.arm.eef_pos()
@@ -87,3 +102,43 @@ class NutAndPegEnv(PandaTaskEnv):
         if self.is_success():
             return 2
         return 1 if self.nut_held() or self.nut_lifted() or self.nut_on_peg() else 0
+
+    # ------------------------------------------------------------------ generation
+    def step_to(self, *args, **kwargs) -> StepInfo:
+        info = super().step_to(*args, **kwargs)
+        self._held_steps = self._held_steps + 1 if self.nut_held() else 0
+        return info
+
+    def mistake_possible(self, subtask: int) -> bool:
+        """Only the grasp can go wrong: the handle's side is the error; the peg's pose is exact."""
+        return subtask == GRASP
+
+    def recovery_done(self, subtask: int) -> bool:
+        """A grasp recovery hands back once the nut has sat between both pads for a few steps."""
+        if subtask == GRASP:
+            return self._held_steps >= HAND_BACK_HELD_STEPS
+        return super().recovery_done(subtask)
+
+    def replay_goals(
+        self,
+        goals: np.ndarray,
+        subtask: int,
+        T_src_world_objects: dict[str, np.ndarray],
+        T_src_world_eef: np.ndarray,
+    ) -> np.ndarray:
+        """The goals, or the same goals with the hand half a turn about its approach axis.
+
+        Grasp (the hand empty at the start): whichever starts nearer the hand's orientation. Place
+        (the nut held): whichever holds the nut on the source's side of the hand, so it arrives
+        where the source's did.
+        """
+        turned = goals.copy()
+        turned[:, :3, :3] = goals[:, :3, :3] @ HALF_TURN
+        R_world_eef = self.eef_pose()[:3, :3]
+        if subtask == GRASP:
+            turn = rotation_angle(R_world_eef, turned[0][:3, :3]) < rotation_angle(R_world_eef, goals[0][:3, :3])
+        else:
+            R_nut_eef_now = self.true_object_poses()["nut"][:3, :3].T @ R_world_eef
+            R_nut_eef_src = T_src_world_objects["nut"][:3, :3].T @ T_src_world_eef[:3, :3]
+            turn = rotation_angle(R_nut_eef_now, R_nut_eef_src) > np.pi / 2
+        return turned if turn else goals
