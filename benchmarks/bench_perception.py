@@ -1,6 +1,6 @@
 r"""Cube pose: right or rejected, on D415-model frames with occluders and distractors; before and after the checks.
 
-Run (one core, idle machine):
+Run (one core, idle machine; on a machine other work shares, add --clock cpu):
     MUJOCO_GL=egl OMP_NUM_THREADS=1 taskset -c 0 .venv/bin/python benchmarks/bench_perception.py \
         --split test --frames 100 --out outputs/bench_perception_test.json
 
@@ -21,6 +21,7 @@ import argparse
 import json
 import logging
 import os
+import time
 from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -36,6 +37,12 @@ def main() -> None:
     parser.add_argument("--split", choices=["dev", "test"], default="dev")
     parser.add_argument("--frames", type=int, default=60, help="frames of each kind (clean, occluded)")
     parser.add_argument("--out", type=Path, default=None, help="write the report (and per-frame rows) here")
+    parser.add_argument(
+        "--clock",
+        choices=["wall", "cpu"],
+        default="wall",
+        help="time the estimator by the wall clock, or by this thread's CPU time (for a machine other work shares)",
+    )
     args = parser.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
 
@@ -48,6 +55,7 @@ def main() -> None:
     from lerobot_robot_igen.perception.cube_pose import CubePoseConfig, CubePoseEstimator
     from lerobot_robot_igen.perception.scoring import as_rows, score_frame, summarize
 
+    clock = time.thread_time if args.clock == "cpu" else time.perf_counter
     env = task_config_class("block_grasp")().make_task_env()
     views = CubeViews(env)
     intrinsics = Intrinsics(*views.camera.intrinsics())
@@ -59,12 +67,12 @@ def main() -> None:
             for view in views.frames(args.split, args.frames, occluded):
                 for name, config in estimators.items():
                     estimator = CubePoseEstimator(intrinsics, view.T_world_camera, config)
-                    scores[name][kind].append(score_frame(estimator, view))
+                    scores[name][kind].append(score_frame(estimator, view, clock))
                 bar.update()
     views.close()
     env.close()
 
-    report = {"split": args.split, "frames_per_kind": args.frames, "results": {}, "rows": {}}
+    report = {"split": args.split, "frames_per_kind": args.frames, "clock": args.clock, "results": {}, "rows": {}}
     for name, kinds in scores.items():
         everything = kinds["clean"] + kinds["occluded"]
         heavy = [s for s in kinds["occluded"] if s.occlusion >= HEAVY_OCCLUSION]
