@@ -1,4 +1,4 @@
-"""A person at LeRobot's keyboard teleoperator, driven on a virtual X display, on every shipped task.
+"""A person at LeRobot's keyboard teleoperator, driven on a virtual X display, on each of the five tasks.
 
 Real parts only: Xvfb is a real X server, xdotool sends real key events through it, pynput
 (inside LeRobot's ``KeyboardEndEffectorTeleop``) receives them. The "person" holds the Up arrow
@@ -57,7 +57,7 @@ print(json.dumps({"flags": episode.is_intervention.tolist(), "source": episode.s
 """
 
 
-@pytest.mark.parametrize("task", ["block_grasp", "nut_insertion"])
+@pytest.mark.parametrize("task", ["block_grasp", "nut_insertion", "two_piece_assembly", "coffee", "nut_and_peg"])
 def test_holding_a_key_takes_over_and_releasing_hands_back(x_display, task):
     env = {**os.environ, "DISPLAY": x_display, "MUJOCO_GL": "egl", "IGEN_TASK": task}
     result = subprocess.run([sys.executable, "-c", SESSION], env=env, capture_output=True, text=True, timeout=300)
