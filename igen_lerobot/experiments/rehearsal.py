@@ -166,7 +166,12 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
         f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for training seed "
         f"{settings['seed']}" + (" (the table's first)" if settings["seed"] == table["train_seeds"][0] else "")
     )
-    print(f"checkpoints: per row, {choice}")
+    trial_choice = (
+        f"the table's test trials (seed {settings['trial_seed']}), which no checkpoint choice saw"
+        if settings["trial_seed"] == table["test_seed"]
+        else f"trials from seed {settings['trial_seed']} (--trial_seed; the table's test seed is {table['test_seed']})"
+    )
+    print(f"checkpoints: per row, {choice}; trials: {settings['trials']} of {trial_choice}")
 
     def report_of(row: str, path: str) -> Path:
         return out / "reports" / row / f"{path}.json"
@@ -212,6 +217,7 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
         "seed": settings["seed"],
         "checkpoint_choice": choice,
         "trial_seed": settings["trial_seed"],
+        "trial_choice": trial_choice,
         "trials": settings["trials"],
         "max_steps": settings["max_steps"],
         "paths": {p: PATHS[p] for p in cfg.paths},

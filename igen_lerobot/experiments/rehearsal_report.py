@@ -72,9 +72,9 @@ def render_rehearsal(result: dict, notes: str = "") -> list[str]:
         f"## {result['task'].replace('_', ' ').title()} rehearsal: the sim-to-real rows through the deployment paths",
         "",
         f"Each row's checkpoint is {result['checkpoint_choice']}. Every path runs the same "
-        f"{result['trials']} trials (seed {result['trial_seed']}: the table's test trials unless the JSON "
-        "says otherwise), each cell successes/trials and its Wilson 95% interval. The paper's columns are "
-        f"its own policies: {paper['sim_trials']} trials in simulation, {paper['real_trials']} on a real Franka.",
+        f"{result['trials']} trials, {result['trial_choice']}, episodes of at most {result['max_steps']} steps; "
+        "each cell is successes/trials and its Wilson 95% interval. The paper's columns are its own "
+        f"policies: {paper['sim_trials']} trials in simulation, {paper['real_trials']} on a real Franka.",
         "",
         "| Variant | chosen step | "
         + " | ".join(result["paths"][p] for p in paths)
