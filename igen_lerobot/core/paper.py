@@ -41,13 +41,18 @@ class PaperTable:
     success: Mapping[str, int] = field(default_factory=dict)  # the paper's numbers, for the rows it reports
     caption: str = ""  # where in the paper
     name: str = ""  # igen-table --table=<name> picks it; "" is the table of its reveal mode
+    # the same policies zero-shot on a real robot [%], for the rows the paper ran there (sim-to-real table)
+    real: Mapping[str, int] = field(default_factory=dict)
+    real_trials: int = 0  # real trials per row behind ``real``
 
     def __post_init__(self) -> None:
-        unknown = [r for r in (*self.rows, *self.success) if not is_variant(r)]
+        unknown = [r for r in (*self.rows, *self.success, *self.real) if not is_variant(r)]
         if unknown:
             raise ValueError(
                 f"paper table rows {unknown} are not igen-table variants {VARIANTS} or igen_<n> / source_int_<n>"
             )
-        missing = [r for r in self.success if r not in self.rows]
+        missing = [r for r in (*self.success, *self.real) if r not in self.rows]
         if missing:
             raise ValueError(f"paper numbers for {missing}, which are not among the table's rows {self.rows}")
+        if bool(self.real) != (self.real_trials > 0):
+            raise ValueError("a paper table's real column needs its number of trials (real_trials), and vice versa")

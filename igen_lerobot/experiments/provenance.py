@@ -46,8 +46,11 @@ def provenance_problems(result: dict) -> list[str]:
     Every recorded command's step must name a commit of a clean checkout, and the config must be
     the table's full config, so that the commands and the commit regenerate the numbers.
     """
+    from igen_lerobot.experiments.config_rehearsal import RehearsalConfig
     from igen_lerobot.experiments.config_table import TableConfig
+    from igen_lerobot.experiments.rehearsal_report import is_rehearsal
 
+    config_class = RehearsalConfig if is_rehearsal(result) else TableConfig
     problems = []
     code = result.get("code") or {}
     if not code.get("commit"):
@@ -62,8 +65,8 @@ def provenance_problems(result: dict) -> list[str]:
         elif made_by.get("dirty"):
             problems.append(f"step {step}: made with uncommitted changes at {made_by['commit'][:10]}")
     config = result.get("config")
-    fields = set(TableConfig.__dataclass_fields__)
+    fields = set(config_class.__dataclass_fields__)
     if not isinstance(config, dict) or set(config) != fields:
         missing = sorted(fields - set(config or {}))
-        problems.append(f"config is not a whole TableConfig (missing {missing})")
+        problems.append(f"config is not a whole {config_class.__name__} (missing {missing})")
     return problems

@@ -54,12 +54,16 @@ class StepFailedError(IgenError, RuntimeError):
     """A command of the table failed; the message names it and the end of its log."""
 
 
-class TableRun:
-    """Runs and records the commands; skips those whose output is already complete."""
+class StepRunner:
+    """Runs and records the commands of a resumable run in ``out``; skips those whose output is already complete.
 
-    def __init__(self, cfg: TableConfig) -> None:
-        self.cfg = cfg
-        self.out = Path(cfg.output_dir)
+    ``in_process``: call each console script's entry point in this process (same arguments, recorded
+    the same) instead of a subprocess.
+    """
+
+    def __init__(self, out: Path, in_process: bool = False) -> None:
+        self.out = Path(out)
+        self.in_process = in_process
         self.bin = Path(sys.executable).parent
         self.commands: list[dict] = []
         self.code = code_version()
@@ -89,7 +93,7 @@ class TableRun:
         command = execute or command
         logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
         start = time.perf_counter()
-        if self.cfg.in_process:
+        if self.in_process:
             code = _run_in_process(command, log)
         else:
             with open(log, "a") as sink:
@@ -107,6 +111,14 @@ class TableRun:
 
     def igen(self, tool: str, *args: str) -> list[str]:
         return [str(self.bin / tool), *args]
+
+
+class TableRun(StepRunner):
+    """The steps of one ``igen-table`` run, in its ``--output_dir``."""
+
+    def __init__(self, cfg: TableConfig) -> None:
+        super().__init__(Path(cfg.output_dir), cfg.in_process)
+        self.cfg = cfg
 
 
 def _read_json(path: Path, default):
@@ -215,6 +227,30 @@ def train_dir(run: TableRun, variant: str, seed: int) -> Path:
     return run.out / "train" / variant / f"seed{seed}"
 
 
+def validation_report(table_dir: Path, variant: str, seed: int) -> Path:
+    """Where a training run's checkpoints were validated: ``eval/<variant>/seed<k>/validation.json``."""
+    return Path(table_dir) / "eval" / variant / f"seed{seed}" / "validation.json"
+
+
+def chosen_result(validation: dict) -> EvalResult:
+    """The checkpoint a table reports for a training run: the best on its validation trials."""
+    return best_result([EvalResult(**r) for r in validation["results"]])
+
+
+def chosen_checkpoint(table_dir: Path, variant: str, seed: int) -> tuple[int, Path]:
+    """``(step, pretrained_model/)`` of the checkpoint a finished table chose for ``variant``'s run with ``seed``."""
+    table_dir = Path(table_dir)
+    report = validation_report(table_dir, variant, seed)
+    if not report.exists():
+        raise ConfigError(
+            f"{table_dir} has no validation of {variant} with training seed {seed} ({report}); finish its "
+            f"igen-table run first, or pick a row and seed it has"
+        )
+    steps = json.loads((table_dir / "table_config.json").read_text())["train"]["steps"]
+    step = chosen_result(json.loads(report.read_text())).step
+    return step, step_checkpoint(table_dir / "train" / variant / f"seed{seed}", steps, step)
+
+
 def train(run: TableRun, variant: str, dataset: Path, seed: int) -> Path:
     """``lerobot-train`` on a variant's dataset with one seed (same config for all); returns the last checkpoint."""
     cfg = replace(run.cfg.train, seed=seed, extra_args=list(run.cfg.train.extra_args))
@@ -252,12 +288,12 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     validation = _eval(
         run,
         f"validate_{variant}_seed{seed}",
-        folder / "validation.json",
+        validation_report(run.out, variant, seed),
         [f"--train_dir={trained}", f"--every={cfg.eval_every}"],
         cfg.n_val_trials,
         cfg.val_seed,
     )
-    chosen = best_result([EvalResult(**r) for r in validation["results"]])
+    chosen = chosen_result(validation)
     checkpoint = step_checkpoint(trained, cfg.train.steps, chosen.step)
     test = _eval(
         run,

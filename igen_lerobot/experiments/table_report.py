@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from igen_lerobot.core.paper import VARIANTS
+from igen_lerobot.experiments.rehearsal_report import is_rehearsal, render_rehearsal
 
 SUPERSEDED = "superseded"  # subfolder of tables kept for the record: one seed, checkpoint chosen on the reported trials
 STUDY = "reproducibility.md"  # why earlier tables did not reproduce, measured: rendered after the page's introduction
@@ -22,7 +23,7 @@ def _with_notes(path: Path) -> tuple[dict, str]:
 
 
 def load_results(folder: Path) -> list[tuple[dict, str]]:
-    """Every table JSON in ``folder`` with its hand-written reading (``<name>.notes.md``, may be empty)."""
+    """Every table (and rehearsal) JSON in ``folder`` with its reading (``<name>.notes.md``, may be empty)."""
     return [_with_notes(path) for path in sorted(Path(folder).glob("*.json"))]
 
 
@@ -93,9 +94,13 @@ def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str
         "those files.",
         "",
     ]
+    rehearsals = [(result, notes) for result, notes in tables if is_rehearsal(result)]
+    tables = [(result, notes) for result, notes in tables if not is_rehearsal(result)]
     lines += render_main_table([result for result, _ in tables])
     for result, notes in tables:
         lines += render_markdown(result, notes)
+    for result, notes in rehearsals:  # a finished table's checkpoints through the deployment paths
+        lines += render_rehearsal(result, notes)
     if study.strip():
         lines += [study.strip(), ""]
     if superseded:

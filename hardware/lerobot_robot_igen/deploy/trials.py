@@ -206,6 +206,8 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         "robot": cfg.robot.get_choice_name(type(cfg.robot)),
         "perception": cfg.perception.get_choice_name(type(cfg.perception)),
         "hand_orientation": cfg.hand_orientation,
+        "seed": cfg.seed,
+        "trial_seeds": [episode_seed(cfg.seed, i) for i in range(len(outcomes))],  # igen-eval's, in a rehearsal
         "deployment": _summary("deployment", outcomes),
         "per_trial": [o.to_json() for o in outcomes],
         "loop": {"step": timing_stats(step_times), "period": timing_stats(period_times)},

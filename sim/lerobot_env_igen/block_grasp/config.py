@@ -31,7 +31,9 @@ class BlockGraspEnvConfig(PandaTaskEnvConfig):
             reveal=Reveal.FULL,
             rows=VARIANTS,
             success={"base": 6, "source_int": 26, "mg_demo": 42, "igen_no_policy": 86, "igen": 100},
-            caption="sim-to-real table, Block Grasp in simulation",
+            caption="sim-to-real table, Block Grasp in simulation (50 trials) and on a real Franka (10 trials)",
+            real={"base": 0, "source_int": 10, "mg_demo": 50, "igen_no_policy": 60, "igen": 90},
+            real_trials=10,
         ),
     )
 

@@ -1,0 +1,254 @@
+"""The rehearsal table: a finished Block Grasp table's chosen checkpoints through igen-eval and the deployment paths.
+
+Per row of the paper's sim-to-real table (Base, Source Int, MG Demo, I-Gen − Policy, I-Gen), the
+checkpoint the table chose for one training seed runs on the same N trials through three paths:
+
+- ``eval``: ``igen-eval``, the training simulator's own rollout;
+- ``rendered``: ``igen-deploy`` on the MuJoCo arm with a simulated D415 through the real ICP code;
+- ``franky``: ``igen-deploy`` through the franky backend against franky-sim (another simulator
+  behind libfranka's protocol, paced at 20 Hz), started and stopped here.
+
+A console script of its own (``igen-rehearse``) rather than ``igen-table --rehearse``: it reads a
+finished table instead of making one, and its flags (rows, paths, trials, franky-sim) share nothing
+with the table's protocol, which ``igen-table`` refuses to change on a resumed run. It reuses the
+table's machinery: every (row, path) is one recorded command run by :class:`StepRunner` (skipped
+when its report exists, so a rerun resumes; commit and wall time per step in ``step_commits.json``
+and ``step_times.json``), and its JSON goes into the results folder, whose page renders it.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import shutil
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.evaluation.trials import wilson_interval
+from igen_lerobot.experiments.config_rehearsal import PATHS, RehearsalConfig
+from igen_lerobot.experiments.rehearsal_report import KIND, ordering
+from igen_lerobot.experiments.table import StepFailedError, StepRunner, chosen_checkpoint
+from igen_lerobot.experiments.table_report import render_results_page, results_folder
+from igen_lerobot.experiments.table_steps import variant_label
+
+logger = logging.getLogger(__name__)
+
+TASK = "block_grasp"  # the only task the cameras perceive, and the paper's sim-to-real task
+# settings whose change would mix two protocols in one rehearsal (the rows and paths may grow)
+FIXED = ("table_dir", "seed", "trial_seed", "trials", "max_steps", "device")
+
+
+def read_table_config(table_dir: Path) -> dict:
+    """A finished table's ``table_config.json`` (checked: a Block Grasp table under full observability)."""
+    path = Path(table_dir) / "table_config.json"
+    if not path.exists():
+        raise ConfigError(f"--table_dir={table_dir} holds no igen-table run (no table_config.json)")
+    table = json.loads(path.read_text())
+    if table["task"] != TASK or table.get("reveal") not in (None, "full") or table.get("table"):
+        raise ConfigError(
+            f"--table_dir={table_dir} is a {table['task']} table (reveal {table.get('reveal')}, "
+            f"table {table.get('table') or 'main'}); the rehearsal needs igen-table --task={TASK}'s main table"
+        )
+    return table
+
+
+def resolved_settings(cfg: RehearsalConfig, table: dict) -> dict:
+    """The settings the steps run with, defaults taken from the table; checked against a resumed run's."""
+    settings = {
+        "table_dir": str(Path(cfg.table_dir).resolve()),
+        "seed": cfg.seed if cfg.seed is not None else table["train_seeds"][0],
+        "trial_seed": cfg.trial_seed if cfg.trial_seed is not None else table["test_seed"],
+        "trials": cfg.trials,
+        "max_steps": cfg.max_steps,
+        "device": cfg.device or table["train"]["device"],
+    }
+    if settings["seed"] not in table["train_seeds"]:
+        raise ConfigError(f"--seed={settings['seed']} is not one of the table's training seeds {table['train_seeds']}")
+    return settings
+
+
+def check_resumed(out: Path, settings: dict) -> None:
+    """Refuse to resume a rehearsal under settings that change what its finished steps made."""
+    recorded_file = out / "rehearsal_config.json"
+    if not recorded_file.exists():
+        out.mkdir(parents=True, exist_ok=True)
+        recorded_file.write_text(json.dumps(settings, indent=2))
+        return
+    recorded = json.loads(recorded_file.read_text())
+    changed = [f"{k}: {recorded.get(k)} -> {settings[k]}" for k in FIXED if recorded.get(k) != settings[k]]
+    if changed:
+        raise ConfigError(
+            f"{out} holds a rehearsal made with other settings ({'; '.join(changed)}); give the same flags to "
+            "resume it, or a new --output_dir"
+        )
+
+
+def path_command(
+    runner: StepRunner, path: str, checkpoint: Path, settings: dict, report: Path, cfg: RehearsalConfig
+) -> list[str]:
+    """The public command of one path on one checkpoint, as a user would type it."""
+    policy = [f"--policy.path={checkpoint}", f"--policy.device={settings['device']}"]
+    seeds = [f"--seed={settings['trial_seed']}", f"--output={report}"]
+    if path == "eval":
+        return runner.igen(
+            "igen-eval",
+            f"--env.type={TASK}",
+            f"--env.episode_length={settings['max_steps']}",
+            *policy,
+            f"--n_trials={settings['trials']}",
+            *seeds,
+        )
+    robot = (
+        ["--robot.type=sim", "--perception.type=rendered"]
+        if path == "rendered"
+        else [
+            "--robot.type=franky",
+            f"--robot.host={cfg.franky_host}",
+            "--perception.type=franky_sim",
+            f"--perception.port={cfg.franky_scene_port}",
+        ]
+    )
+    trials = [f"--trials={settings['trials']}", f"--max_steps={settings['max_steps']}"]
+    return runner.igen("igen-deploy", f"--task={TASK}", *policy, *robot, *trials, *seeds)
+
+
+def run_step(runner: StepRunner, name: str, command: list[str], report: Path) -> None:
+    """One (row, path): skipped when its report exists; a failed run leaves no report, so a rerun redoes it."""
+    if not (report.exists() or runner.in_process or shutil.which(command[0])):
+        raise ConfigError(f"{Path(command[0]).name} is not installed here; run `make setup` (scripts/setup.sh)")
+    try:
+        runner.run(name, command, report)
+    except StepFailedError:
+        report.unlink(missing_ok=True)  # igen-deploy writes the trials of a run it stopped, then fails
+        raise
+
+
+def path_result(path: str, report: dict) -> dict:
+    """successes/trials, interval, per-trial outcomes and seeds of one path's report."""
+    if path == "eval":
+        best = report["best"]
+        per_trial = list(best["per_trial"])
+        seeds = [episode_seed(report["seed"], i) for i in range(report["n_trials"])]
+        faults: list[str] = []
+    else:
+        per_trial = [trial["success"] for trial in report["per_trial"]]
+        seeds = report["trial_seeds"]
+        faults = report["deployment"]["faults"]
+    successes, trials = sum(per_trial), len(per_trial)
+    return {
+        "successes": successes,
+        "trials": trials,
+        "success_rate": successes / trials,
+        "ci95": list(wilson_interval(successes, trials)),
+        "per_trial": per_trial,
+        "trial_seeds": seeds,
+        "faults": faults,
+    }
+
+
+def run_rehearsal(cfg: RehearsalConfig) -> dict:
+    """Run every (row, path) not yet done; write the rehearsal's JSON and re-render the results page."""
+    start = time.perf_counter()
+    table_dir = Path(cfg.table_dir)
+    table = read_table_config(table_dir)
+    paper = task_config_class(TASK)().paper_table()
+    rows = cfg.rows or [r for r in paper.rows if r in paper.real]
+    settings = resolved_settings(cfg, table)
+    out = Path(cfg.output_dir) if cfg.output_dir else table_dir / "rehearsal"
+    check_resumed(out, settings)
+    runner = StepRunner(out, cfg.in_process)
+    chosen = {row: chosen_checkpoint(table_dir, row, settings["seed"]) for row in rows}
+    choice = (
+        f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for training seed "
+        f"{settings['seed']}" + (" (the table's first)" if settings["seed"] == table["train_seeds"][0] else "")
+    )
+    trial_choice = (
+        f"the table's test trials (seed {settings['trial_seed']}), which no checkpoint choice saw"
+        if settings["trial_seed"] == table["test_seed"]
+        else f"trials from seed {settings['trial_seed']} (--trial_seed; the table's test seed is {table['test_seed']})"
+    )
+    print(f"checkpoints: per row, {choice}; trials: {settings['trials']} of {trial_choice}")
+
+    def report_of(row: str, path: str) -> Path:
+        return out / "reports" / row / f"{path}.json"
+
+    def run_path(path: str) -> None:
+        for row in rows:
+            command = path_command(runner, path, chosen[row][1], settings, report_of(row, path), cfg)
+            run_step(runner, f"{path}_{row}", command, report_of(row, path))
+
+    for path in cfg.paths:
+        pending = any(not report_of(row, path).exists() for row in rows)
+        if path == "franky" and pending:
+            from lerobot_robot_igen.arm.franky_sim_server import running  # the hardware extra, needed here only
+
+            log = out / "logs" / "franky_sim.log"
+            with running(cfg.franky_host, scene_port=cfg.franky_scene_port, log=log):
+                run_path(path)
+        else:
+            run_path(path)
+
+    result_rows = []
+    for row in rows:
+        results = {p: path_result(p, json.loads(report_of(row, p).read_text())) for p in cfg.paths}
+        result_rows.append(
+            {
+                "variant": row,
+                "label": variant_label(row),
+                "chosen_step": chosen[row][0],
+                "checkpoint": str(chosen[row][1]),
+                "paper_sim": paper.success.get(row),
+                "paper_real": paper.real.get(row),
+                "results": results,
+            }
+        )
+    ran = {step["step"] for step in runner.commands}
+    name = f"{TASK}_rehearsal"
+    result = {
+        "kind": KIND,
+        "task": TASK,
+        "name": name,
+        "config": asdict(cfg),
+        "table": {"dir": settings["table_dir"], "train_seeds": table["train_seeds"], "test_seed": table["test_seed"]},
+        "seed": settings["seed"],
+        "checkpoint_choice": choice,
+        "trial_seed": settings["trial_seed"],
+        "trial_choice": trial_choice,
+        "trials": settings["trials"],
+        "max_steps": settings["max_steps"],
+        "paths": {p: PATHS[p] for p in cfg.paths},
+        "paper": {"sim_trials": 50, "real_trials": paper.real_trials},
+        "rows": result_rows,
+        "results": [{"variant": r["variant"], "path": p, **r["results"][p]} for r in result_rows for p in cfg.paths],
+        "ordering": {p: ordering(result_rows, p) for p in cfg.paths},
+        "code": runner.code,
+        "step_code": {step: runner.versions.get(step) for step in sorted(ran)},
+        "commands": runner.commands,
+        "wall_time_s": time.perf_counter() - start,
+        "step_times_s": {step: t for step, t in runner.timings.items() if step in ran},
+    }
+    folder = results_folder(Path(cfg.results))
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"{name}.json").write_text(json.dumps(result, indent=2))
+    Path(cfg.results).write_text(render_results_page(folder))
+    return result
+
+
+def rehearse_command(cfg: RehearsalConfig) -> dict:
+    """``igen-rehearse``: run the rehearsal and print it."""
+    result = run_rehearsal(cfg)
+    for row in result["rows"]:
+        cells = ", ".join(
+            f"{p} {r['successes']}/{r['trials']} ({100 * r['ci95'][0]:.0f}-{100 * r['ci95'][1]:.0f}%)"
+            for p, r in row["results"].items()
+        )
+        print(
+            f"{row['label']:>16} (step {row['chosen_step']}): {cells}; paper sim {row['paper_sim']}, "
+            f"real {row['paper_real']}"
+        )
+    print(f"Wrote {cfg.results} and {results_folder(Path(cfg.results)) / (result['name'] + '.json')}")
+    return result

@@ -1,0 +1,224 @@
+"""igen-rehearse: a finished table's chosen checkpoints through igen-eval and the deployment paths.
+
+The end-to-end runs use a fake table whose rows all chose the tiny BC-RNN checkpoint of
+``bc_rnn_checkpoint`` (the plumbing, not the rates), one trial and short episodes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import asdict
+from pathlib import Path
+
+import pytest
+
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.experiments.config_rehearsal import PATHS, RehearsalConfig
+from igen_lerobot.experiments.config_table import TableConfig
+from igen_lerobot.experiments.provenance import provenance_problems
+from igen_lerobot.experiments.rehearsal_report import ordering
+from igen_lerobot.experiments.table_report import render_page
+from igen_lerobot.training.config_train import TrainConfig
+
+ROWS = ["base", "igen"]
+SEED = 7
+
+
+def fake_table(tmp_path: Path, checkpoint: Path) -> Path:
+    """A table dir laid out as igen-table leaves it, whose runs of ROWS (seed 7) all chose ``checkpoint``."""
+    train_out = checkpoint.parents[2]  # <output_dir>/checkpoints/<step>/pretrained_model (not last/)
+    step = int(checkpoint.parent.name)
+    table = tmp_path / "table"
+    cfg = TableConfig(train=TrainConfig(steps=step), train_seeds=[SEED], n_val_trials=1)
+    table.mkdir()
+    (table / "table_config.json").write_text(json.dumps(asdict(cfg)))
+    for row in ROWS:
+        (table / "train" / row).mkdir(parents=True)
+        (table / "train" / row / f"seed{SEED}").symlink_to(train_out)
+        result = {"policy": str(checkpoint), "trials": 1, "successes": 0, "success_rate": 0.0, "ci95": [0, 0.79]}
+        result |= {"mean_steps": 10.0, "seconds": 1.0, "per_trial": [False], "step": step}
+        validation = table / "eval" / row / f"seed{SEED}" / "validation.json"
+        validation.parent.mkdir(parents=True)
+        validation.write_text(json.dumps({"results": [result]}))
+    return table
+
+
+def rehearse(table: Path, tmp_path: Path, paths: list[str], **kwargs) -> dict:
+    from igen_lerobot.experiments.rehearsal import run_rehearsal
+
+    cfg = RehearsalConfig(
+        table_dir=str(table),
+        rows=ROWS,
+        trials=1,
+        paths=paths,
+        max_steps=20,
+        in_process=True,
+        results=str(tmp_path / "results.md"),
+        **kwargs,
+    )
+    return run_rehearsal(cfg)
+
+
+def check_report(result: dict, table: Path, tmp_path: Path, paths: list[str]) -> None:
+    """A row per (row, path), the same trials on every path, intervals, the page rendered from the JSON."""
+    assert [(r["variant"], r["path"]) for r in result["results"]] == [(row, p) for row in ROWS for p in paths]
+    seeds = {json.dumps(r["trial_seeds"]) for r in result["results"]}
+    assert len(seeds) == 1 and len(json.loads(seeds.pop())) == 1
+    for entry in result["results"]:
+        low, high = entry["ci95"]
+        assert entry["trials"] == 1 and 0 <= low <= entry["success_rate"] <= high <= 1
+    assert result["trial_seed"] == TableConfig().test_seed and result["seed"] == SEED
+    assert "training seed 7 (the table's first)" in result["checkpoint_choice"]
+    assert result["trial_choice"].startswith("the table's test trials (seed 2000003)")
+    assert set(result["step_times_s"]) == {f"{p}_{row}" for row in ROWS for p in paths}
+    page = (tmp_path / "results.md").read_text()
+    assert "rehearsal: the sim-to-real rows" in page and "| I-Gen | 3 |" in page
+    saved = json.loads((tmp_path / "results" / "block_grasp_rehearsal.json").read_text())
+    assert saved["results"] == result["results"]
+    problems = provenance_problems(saved)
+    assert all("uncommitted changes" in p for p in problems), problems  # a developer's tree may be dirty
+
+
+def test_rehearsal_runs_igen_eval_and_the_mujoco_arm_on_the_same_trials_and_resumes(bc_rnn_checkpoint, tmp_path):
+    table = fake_table(tmp_path, Path(bc_rnn_checkpoint).resolve())
+    paths = ["eval", "rendered"]
+    result = rehearse(table, tmp_path, paths)
+    check_report(result, table, tmp_path, paths)
+    out = table / "rehearsal"
+    times = (out / "step_times.json").read_text()
+    reports = {p: p.stat().st_mtime_ns for p in (out / "reports").rglob("*.json")}
+    assert len(reports) == 4 and json.loads((out / "step_commits.json").read_text()).keys() == json.loads(times).keys()
+
+    again = rehearse(table, tmp_path, paths)  # nothing to redo
+    assert (out / "step_times.json").read_text() == times
+    assert {p: p.stat().st_mtime_ns for p in (out / "reports").rglob("*.json")} == reports
+    assert again["results"] == result["results"]
+
+    # an interrupted step (no report) is redone, alone
+    (out / "reports" / "igen" / "rendered.json").unlink()
+    rehearse(table, tmp_path, paths)
+    redone = json.loads((out / "step_times.json").read_text())
+    assert [s for s, t in redone.items() if t != json.loads(times)[s]] == ["rendered_igen"]
+
+
+@pytest.mark.realtime
+def test_rehearsal_runs_franky_on_franky_sim_started_by_itself(bc_rnn_checkpoint, tmp_path):
+    from lerobot_robot_igen.arm.franky_sim_server import free_loopback
+
+    table = fake_table(tmp_path, Path(bc_rnn_checkpoint).resolve())
+    paths = ["eval", "franky"]
+    port = 20000 + (os.getpid() + 7) % 20000
+    result = rehearse(table, tmp_path, paths, franky_host=free_loopback(), franky_scene_port=port)
+    check_report(result, table, tmp_path, paths)
+    assert "READY" in (table / "rehearsal" / "logs" / "franky_sim.log").read_text()
+    times = (table / "rehearsal" / "step_times.json").read_text()
+    rehearse(table, tmp_path, paths, franky_host=free_loopback(), franky_scene_port=port)  # no server is started
+    assert (table / "rehearsal" / "step_times.json").read_text() == times
+
+
+def test_a_resumed_rehearsal_refuses_settings_that_change_finished_steps(tmp_path):
+    from igen_lerobot.experiments.rehearsal import check_resumed
+
+    settings = {"table_dir": "t", "seed": 0, "trial_seed": 1, "trials": 20, "max_steps": 200, "device": "cpu"}
+    check_resumed(tmp_path, settings)
+    check_resumed(tmp_path, settings)
+    with pytest.raises(ConfigError, match="trials: 20 -> 5"):
+        check_resumed(tmp_path, {**settings, "trials": 5})
+
+
+def test_rehearsal_config_names_the_fix():
+    with pytest.raises(ConfigError, match="--table_dir is required"):
+        RehearsalConfig()
+    with pytest.raises(ConfigError, match=r"--paths must be distinct names among \['eval', 'rendered', 'franky'\]"):
+        RehearsalConfig(table_dir="x", paths=["mujoco"])
+    assert RehearsalConfig(table_dir="x", paths=["franky", "eval"]).paths == ["eval", "franky"]
+
+
+def test_a_table_dir_that_is_not_a_block_grasp_table_is_refused(tmp_path):
+    from igen_lerobot.experiments.rehearsal import read_table_config
+
+    with pytest.raises(ConfigError, match="holds no igen-table run"):
+        read_table_config(tmp_path)
+    (tmp_path / "table_config.json").write_text(json.dumps(asdict(TableConfig(task="nut_insertion"))))
+    with pytest.raises(ConfigError, match="needs igen-table --task=block_grasp"):
+        read_table_config(tmp_path)
+
+
+# ------------------------------------------------------------------------------ rendering, synthetic JSON
+PAPER = {"base": (6, 0), "source_int": (26, 10), "mg_demo": (42, 50), "igen_no_policy": (86, 60), "igen": (100, 90)}
+LABELS = {"base": "Base", "source_int": "Source Int", "mg_demo": "MG Demo", "igen_no_policy": "I-Gen − Policy"}
+
+
+def synthetic(successes: dict[str, tuple[int, int, int]], n: int = 20) -> dict:
+    """A rehearsal JSON as igen-rehearse writes it, with made-up successes per row (eval, rendered, franky)."""
+    from igen_lerobot.evaluation.trials import wilson_interval
+
+    rows = []
+    for variant, counts in successes.items():
+        results = {
+            path: {"successes": k, "trials": n, "success_rate": k / n, "ci95": list(wilson_interval(k, n))}
+            for path, k in zip(PATHS, counts, strict=True)
+        }
+        sim, real = PAPER[variant]
+        label = LABELS.get(variant, "I-Gen")
+        rows.append({"variant": variant, "label": label, "chosen_step": 1500, "paper_sim": sim, "paper_real": real})
+        rows[-1]["results"] = results
+    step_code = {f"{p}_{v}": {"commit": "a" * 40, "dirty": False} for v in successes for p in PATHS}
+    return {
+        "kind": "rehearsal",
+        "task": "block_grasp",
+        "name": "block_grasp_rehearsal",
+        "checkpoint_choice": "the one igen-table chose for training seed 1000 (the table's first)",
+        "trials": n,
+        "trial_seed": 2_000_003,
+        "trial_choice": "the table's test trials (seed 2000003), which no checkpoint choice saw",
+        "max_steps": 200,
+        "paths": dict(PATHS),
+        "paper": {"sim_trials": 50, "real_trials": 10},
+        "rows": rows,
+        "step_code": step_code,
+        "commands": [{"step": s, "command": f"igen-eval {s}"} for s in step_code],
+        "wall_time_s": 600.0,
+        "step_times_s": dict.fromkeys(step_code, 60.0),
+    }
+
+
+def test_the_page_renders_a_rehearsal_beside_the_papers_columns_with_the_ordering_rule():
+    result = synthetic(
+        {
+            "base": (1, 0, 0),
+            "source_int": (5, 4, 2),
+            "mg_demo": (9, 10, 12),
+            "igen_no_policy": (17, 11, 12),
+            "igen": (20, 19, 18),
+        }
+    )
+    page = render_page([(result, "A reading.")])
+    assert "## Block Grasp rehearsal: the sim-to-real rows through the deployment paths" in page
+    header = next(line for line in page.splitlines() if line.startswith("| Variant | chosen step |"))
+    assert header.endswith("| paper sim (50) | paper real (10) |") and all(label in header for label in PATHS.values())
+    assert "| Base | 1500 | 1/20 (1–24%) | 0/20 (0–16%) | 0/20 (0–16%) | 6% | 0% |" in page
+    assert "| I-Gen | 1500 | 20/20 (84–100%) | 19/20 (76–99%) | 18/20 (70–97%) | 100% | 90% |" in page
+    assert "(Base < Source Int < MG Demo < I-Gen − Policy < I-Gen)" in page
+    assert f"- {PATHS['eval']}: holds (strictly increasing)." in page
+    assert f"- {PATHS['rendered']}: holds (strictly increasing)." in page
+    assert f"- {PATHS['franky']}: does not hold (MG Demo and I-Gen − Policy equal)." in page
+    assert "A reading." in page
+    assert "- Code: steps ran at aaaaaaaaaa" in page
+
+
+def test_the_ordering_rule_names_inversions_and_skips_a_path_some_row_lacks():
+    result = synthetic({"base": (3, 3, 3), "source_int": (2, 2, 2), "igen": (20, 20, 20)})
+    assert ordering(result["rows"], "eval") == {
+        "order": ["base", "source_int", "igen"],
+        "holds": False,
+        "inversions": [["base", "source_int"]],
+        "ties": [],
+    }
+    del result["rows"][0]["results"]["franky"]
+    assert ordering(result["rows"], "franky") is None
+    page = "\n".join(render_page([(result, "")]).splitlines())
+    assert f"- {PATHS['eval']}: does not hold (Source Int below Base)." in page
+    assert f"- {PATHS['franky']}: not measured on every row." in page
+    assert "| Base | 1500 | 3/20 (5–36%) | 3/20 (5–36%) | – |" in page
