@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from igen_lerobot.core.belief import Reveal
 
-__all__ = ["DerivedVariant", "PaperTable", "VARIANTS", "flags_tag", "is_variant", "sized_variant"]
+__all__ = ["DerivedVariant", "PaperTable", "VARIANTS", "is_variant", "safe_name", "sized_variant"]
 
 # Every dataset variant igen-table knows, in the paper's order (rows of its tables).
 VARIANTS = ("base", "source_int", "weighted_src_int", "source_demo", "mg_demo", "igen_no_policy", "igen")
@@ -36,9 +36,9 @@ def is_variant(name: str) -> bool:
     return name in VARIANTS or sized_variant(name) is not None
 
 
-def flags_tag(flags: tuple[str, ...]) -> str:
-    """A name-safe form of env flags: ``env_geometry_2`` for ``("--env.geometry=2",)``."""
-    return re.sub(r"[^0-9A-Za-z]+", "_", " ".join(flags)).strip("_")
+def safe_name(text: str) -> str:
+    """``text`` as a file and step name: ``env_geometry_2`` for ``--env.geometry=2``."""
+    return re.sub(r"[^0-9A-Za-z]+", "_", text).strip("_")
 
 
 def _check_env_flags(flags: tuple[str, ...], what: str) -> None:
@@ -73,7 +73,7 @@ class DerivedVariant:
     @property
     def data_tag(self) -> str:
         """The suffix of its datasets' names (``env_geometry_2``)."""
-        return flags_tag(self.data_env)
+        return safe_name(" ".join(self.data_env))
 
 
 @dataclass(frozen=True)

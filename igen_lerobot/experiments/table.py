@@ -32,7 +32,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import ConfigError, IgenError
-from igen_lerobot.core.paper import flags_tag
+from igen_lerobot.core.paper import safe_name
 from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
@@ -288,7 +288,7 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     checkpoint = step_checkpoint(trained, cfg.train.steps, step)
     tests = {}
     for column, flags in (run.columns or {"": ()}).items():
-        suffix = f"_{flags_tag((column,))}" if column else ""
+        suffix = f"_{safe_name(column)}" if column else ""
         tests[column] = _eval(
             run,
             f"test_{variant}_seed{seed}{suffix}",
