@@ -108,6 +108,7 @@ def test_a_table_with_columns_renders_a_cell_per_column_with_the_papers_number()
     assert row["success_rate"] == columns["mixture"]["success_rate"]  # the row's own numbers: the choice column's
     mg = summarise_row("mg_demo_geometry_2", [_seed(7, (0, 50, 25))], 50, dataset, label="MG Demo (geometry 2)",
                        paper_columns={"geometry 1": 0, "geometry 2": 100, "mixture": 50})  # fmt: skip
+    mg["without_base"] = True  # as igen-table marks it
     cfg = TableConfig(task="nut_and_peg", train_seeds=[7, 8])
     result = {
         "task": "nut_and_peg", "reveal": "none", "columns": COLUMNS, "choose_on": "mixture",
@@ -126,3 +127,4 @@ def test_a_table_with_columns_renders_a_cell_per_column_with_the_papers_number()
     )
     assert any(line.startswith("- Columns: every chosen checkpoint is tested in each column") for line in lines)
     assert "geometry 2: `--env.geometry=2`" in "\n".join(lines)
+    assert "- Trained on their own data alone, not D plus it: MG Demo (geometry 2)." in lines

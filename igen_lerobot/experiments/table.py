@@ -405,6 +405,8 @@ def run_table(cfg: TableConfig) -> dict:
                 paper_columns={c: paper.paper_success(variant, c) for c in run.columns},
             )
         )
+        if not trains_with_base(variant, run.derived):
+            rows[-1]["without_base"] = True  # trained on its own data alone, not D plus it
     ran = {step["step"] for step in run.commands}
     result = {
         "task": cfg.task,

@@ -170,6 +170,7 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         f"trials from seed {cfg['val_seed']}; the rate reported is that checkpoint's on {cfg['n_trials']} "
         f"test trials from seed {cfg['test_seed']}. 95% CI: Wilson, on all seeds' test trials together.",
         *_columns_line(result),
+        *_without_base_line(result),
         _code_line(result),
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
@@ -243,6 +244,12 @@ def _columns_line(result: dict) -> list[str]:
         f"its own {result['config']['n_trials']} test trials; the checkpoint is chosen on the "
         f"{result['choose_on']} column's validation trials."
     ]
+
+
+def _without_base_line(result: dict) -> list[str]:
+    """The protocol's line on rows trained without D (a table's own rows may be), where there are any."""
+    alone = [row["label"] for row in result["rows"] if row.get("without_base")]
+    return [f"- Trained on their own data alone, not D plus it: {', '.join(alone)}."] if alone else []
 
 
 def render_superseded(result: dict, notes: str = "") -> list[str]:
