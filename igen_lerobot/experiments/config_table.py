@@ -28,7 +28,8 @@ class TableConfig:
     Every row is trained once per seed of ``train_seeds``; each run's checkpoint is chosen on
     ``n_val_trials`` validation trials and reported on ``n_trials`` test trials that no choice
     ever saw, and the row is the mean over seeds. The first seed's base policy is the one that
-    interventions are collected on and generated with.
+    interventions are collected on and generated with. A table with columns (Nut-and-Peg: one per
+    geometry) tests every chosen checkpoint on ``n_trials`` test trials in each column.
     """
 
     task: str = "block_grasp"
@@ -54,16 +55,21 @@ class TableConfig:
     # run each command inside this process (same arguments, same code, recorded the same) instead of
     # a subprocess: saves the ~20 s of imports per command that dominate small smoke runs
     in_process: bool = False
+    # print every command the table would run, in order, and run none (the checkpoint a test trial
+    # would use is shown as the last one: the choice needs the validation trials)
+    dry_run: bool = False
 
     def __post_init__(self) -> None:
         table = self.paper_table()  # checks --reveal and --table
         if self.variants is None:
             self.variants = list(table.rows) if table is not None else list(VARIANTS)
-        unknown = [v for v in self.variants if not is_variant(v)]
+        derived = list(table.derived) if table is not None else []
+        unknown = [v for v in self.variants if not (is_variant(v) or v in derived)]
         if unknown or not self.variants:
+            own = f", this table's rows {derived}" if derived else ""
             raise ConfigError(
-                f"--variants must be a non-empty list of {list(VARIANTS)} or sized rows igen_<n> / source_int_<n>, "
-                f"got {self.variants}"
+                f"--variants must be a non-empty list of {list(VARIANTS)}{own} or sized rows igen_<n> / "
+                f"source_int_<n>, got {self.variants}"
             )
         if self.train_seeds is None:
             self.train_seeds = [self.train.seed + i for i in range(3)]

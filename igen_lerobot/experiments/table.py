@@ -11,7 +11,10 @@ Datasets (``output_dir/data``, :mod:`~igen_lerobot.experiments.table_steps`): ``
 test environment (corrupted observation, the operator sees the truth) -> ``mg_test_demos``;
 ``igen_no_policy`` and ``igen`` generated from ``source_int``. Each variant trains on D plus its
 part, once per training seed (``train/<variant>/seed<k>``); every run's checkpoint is chosen on
-validation trials and its success measured on test trials no choice has seen.
+validation trials and its success measured on test trials no choice has seen. A table with
+columns (:class:`~igen_lerobot.core.paper.PaperTable`) tests that checkpoint in each column, under
+the column's env flags, on test trials of its own. ``--dry_run=true`` lists every command and runs
+none (:func:`plan`).
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.paper import safe_name
 from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
@@ -39,6 +43,8 @@ from igen_lerobot.experiments.table_steps import (
     VARIANT_WEIGHTS,
     DataStep,
     needed_parts,
+    trains_with_base,
+    variant_kind,
     variant_label,
     variant_part,
 )
@@ -47,7 +53,7 @@ from igen_lerobot.training.lerobot_train import final_checkpoint, run_command, s
 logger = logging.getLogger(__name__)
 
 # config fields a resumed table may change: they do not change what a finished step made
-RESUMABLE_CHANGES = ("variants", "train_seeds", "workers", "in_process", "results", "output_dir")
+RESUMABLE_CHANGES = ("variants", "train_seeds", "workers", "in_process", "results", "output_dir", "dry_run")
 
 
 class StepFailedError(IgenError, RuntimeError):
@@ -58,12 +64,13 @@ class StepRunner:
     """Runs and records the commands of a resumable run in ``out``; skips those whose output is already complete.
 
     ``in_process``: call each console script's entry point in this process (same arguments, recorded
-    the same) instead of a subprocess.
+    the same) instead of a subprocess. ``dry_run``: record the commands, run none.
     """
 
-    def __init__(self, out: Path, in_process: bool = False) -> None:
+    def __init__(self, out: Path, in_process: bool = False, dry_run: bool = False) -> None:
         self.out = Path(out)
         self.in_process = in_process
+        self.dry_run = dry_run
         self.bin = Path(sys.executable).parent
         self.commands: list[dict] = []
         self.code = code_version()
@@ -85,6 +92,8 @@ class StepRunner:
         """
         shown = shlex.join([Path(command[0]).name, *command[1:]])
         self.commands.append({"step": name, "command": shown})
+        if self.dry_run:
+            return
         if done.exists():
             logger.info("%s: done already (%s)", name, done)
             return
@@ -117,8 +126,14 @@ class TableRun(StepRunner):
     """The steps of one ``igen-table`` run, in its ``--output_dir``."""
 
     def __init__(self, cfg: TableConfig) -> None:
-        super().__init__(Path(cfg.output_dir), cfg.in_process)
+        super().__init__(Path(cfg.output_dir), cfg.in_process, cfg.dry_run)
         self.cfg = cfg
+        paper = cfg.paper_table()
+        self.derived = paper.derived if paper is not None else {}  # the table's own rows
+        # evaluation column -> its env flags ({}: the one column of the task's own env), and the
+        # column whose validation trials choose the checkpoints
+        self.columns = dict(paper.columns) if paper is not None else {}
+        self.choose_on = paper.choose_on if paper is not None else ""
 
 
 def _read_json(path: Path, default):
@@ -197,16 +212,20 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
     for step in BASE_STEPS:
         build_step(run, step, policy="")
     base_policy = str(train(run, "base", run.data("base"), cfg.train_seeds[0]))
-    for step in needed_parts(cfg.variants):
+    for step in needed_parts(cfg.variants, derived=run.derived):
         build_step(run, step, base_policy)
 
     datasets = {"base": run.data("base")}
     for variant in cfg.variants:
-        part = variant_part(variant)
+        part = variant_part(variant, run.derived)
         if part is None:
             continue
+        if not trains_with_base(variant, run.derived):
+            datasets[variant] = run.data(part)
+            continue
         merged = run.data(f"train_{variant}")
-        weights = [f"--weights={VARIANT_WEIGHTS[variant]}"] if variant in VARIANT_WEIGHTS else []
+        kind = variant_kind(variant, run.derived)
+        weights = [f"--weights={VARIANT_WEIGHTS[kind]}"] if kind in VARIANT_WEIGHTS else []
         run.run(
             f"merge_{variant}",
             run.igen(
@@ -277,11 +296,18 @@ def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: i
         ),
         report,
     )
-    return json.loads(report.read_text())
+    return {} if cfg.dry_run else json.loads(report.read_text())
 
 
 def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
-    """Choose the run's checkpoint on validation trials, then measure it on the test trials."""
+    """Choose the run's checkpoint on validation trials, then measure it on the test trials (of each column).
+
+    In a table with columns the choice is made on one column's validation trials, the table's
+    ``choose_on`` (Nut-and-Peg: the mixture, where the handle's side is unknown as in use): a
+    choice on one geometry's trials would pick for that geometry, and pooling both geometries'
+    trials measures the mixture again at twice the cost. Every column is then tested on its own
+    trials, all from ``--test_seed`` (the same scenes in each column: only the column's flags differ).
+    """
     cfg = run.cfg
     folder = run.out / "eval" / variant / f"seed{seed}"
     trained = train_dir(run, variant, seed)
@@ -289,58 +315,107 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
         run,
         f"validate_{variant}_seed{seed}",
         validation_report(run.out, variant, seed),
-        [f"--train_dir={trained}", f"--every={cfg.eval_every}"],
+        [*run.columns.get(run.choose_on, ()), f"--train_dir={trained}", f"--every={cfg.eval_every}"],
         cfg.n_val_trials,
         cfg.val_seed,
     )
-    chosen = chosen_result(validation)
-    checkpoint = step_checkpoint(trained, cfg.train.steps, chosen.step)
-    test = _eval(
-        run,
-        f"test_{variant}_seed{seed}",
-        folder / f"test_step{chosen.step}.json",
-        [f"--policy.path={checkpoint}"],
-        cfg.n_trials,
-        cfg.test_seed,
-    )["best"]
-    return {
+    # a dry run has no trials to choose on: its plan shows the last checkpoint
+    chosen = None if cfg.dry_run else chosen_result(validation)
+    step = cfg.train.steps if chosen is None else chosen.step
+    checkpoint = step_checkpoint(trained, cfg.train.steps, step)
+    tests = {}
+    for column, flags in (run.columns or {"": ()}).items():
+        suffix = f"_{safe_name(column)}" if column else ""
+        tests[column] = _eval(
+            run,
+            f"test_{variant}_seed{seed}{suffix}",
+            folder / f"test{suffix}_step{step}.json",
+            [*flags, f"--policy.path={checkpoint}"],
+            cfg.n_trials,
+            cfg.test_seed,
+        ).get("best", {})
+    if chosen is None:
+        return {}
+    keys = ("successes", "trials", "success_rate", "ci95")
+    kept = {column: {k: test[k] for k in keys} for column, test in tests.items()}
+    result = {
         "seed": seed,
         "chosen_step": chosen.step,
         "validation_rate": chosen.success_rate,
         "validation": {r["step"]: r["success_rate"] for r in validation["results"]},
-        "test": {k: test[k] for k in ("successes", "trials", "success_rate", "ci95")},
+        # a table with columns: "test" is the choice column's, so readers of one-column tables read it alike
+        "test": kept[run.choose_on],
     }
+    return {**result, "columns": kept} if run.columns else result
 
 
-def summarise_row(variant: str, seeds: list[dict], paper: int | None, dataset: dict) -> dict:
-    """A row: the mean test rate over training seeds, its spread, and a Wilson interval on the pooled trials.
-
-    The interval covers trial-to-trial chance only; the spread (min, max, standard deviation) is
-    the training seeds' share, shown beside it rather than folded in.
-    """
-    rates = [s["test"]["success_rate"] for s in seeds]
+def _pooled(tests: list[dict]) -> dict:
+    """Seeds' test results: their mean rate, spread, and a Wilson interval on the pooled trials."""
+    rates = [t["success_rate"] for t in tests]
     mean = sum(rates) / len(rates)
     std = (sum((r - mean) ** 2 for r in rates) / (len(rates) - 1)) ** 0.5 if len(rates) > 1 else 0.0
-    successes, trials = sum(s["test"]["successes"] for s in seeds), sum(s["test"]["trials"] for s in seeds)
+    successes, trials = sum(t["successes"] for t in tests), sum(t["trials"] for t in tests)
     return {
-        "variant": variant,
-        "label": variant_label(variant),
         "success_rate": mean,
         "std": std,
         "min": min(rates),
         "max": max(rates),
         "ci95": list(wilson_interval(successes, trials)),
         "trials": trials,
+    }
+
+
+def summarise_row(
+    variant: str,
+    seeds: list[dict],
+    paper: int | None,
+    dataset: dict,
+    label: str | None = None,
+    paper_columns: dict[str, int | None] | None = None,
+) -> dict:
+    """A row: the mean test rate over training seeds, its spread, and a Wilson interval on the pooled trials.
+
+    The interval covers trial-to-trial chance only; the spread (min, max, standard deviation) is
+    the training seeds' share, shown beside it rather than folded in. Seeds tested in columns
+    give the row the same summary per column (``columns``, with the paper's number of each);
+    its own numbers are then the choice column's.
+    """
+    row = {
+        "variant": variant,
+        "label": label or variant_label(variant),
+        **_pooled([s["test"] for s in seeds]),
         "validation_rate": sum(s["validation_rate"] for s in seeds) / len(seeds),
         "seeds": seeds,
         "paper": paper,
         "dataset": dataset,
     }
+    if "columns" in seeds[0]:
+        paper_columns = paper_columns or {}
+        row["columns"] = {
+            column: {**_pooled([s["columns"][column] for s in seeds]), "paper": paper_columns.get(column)}
+            for column in seeds[0]["columns"]
+        }
+    return row
 
 
 def _dataset_size(root: Path) -> dict:
     info = json.loads((root / "meta" / "info.json").read_text())
     return {"episodes": info["total_episodes"], "frames": info["total_frames"]}
+
+
+def plan(cfg: TableConfig) -> list[dict]:
+    """Every command the table runs, in order (step and command), running none: ``--dry_run=true``.
+
+    The same code as a run, so the plan is what a run records; a test trial's checkpoint is shown
+    as the last one, since the choice needs the validation trials' results.
+    """
+    run = TableRun(replace(cfg, dry_run=True))
+    datasets = build_datasets(run)
+    for variant in cfg.variants:
+        for seed in cfg.train_seeds:
+            train(run, variant, datasets[variant], seed)
+            evaluate_seed(run, variant, seed)
+    return run.commands
 
 
 def run_table(cfg: TableConfig) -> dict:
@@ -357,13 +432,24 @@ def run_table(cfg: TableConfig) -> dict:
         for seed in cfg.train_seeds:
             train(run, variant, datasets[variant], seed)
             seeds.append(evaluate_seed(run, variant, seed))
-        paper_rate = None if paper is None else paper.success.get(variant)
-        rows.append(summarise_row(variant, seeds, paper_rate, _dataset_size(datasets[variant])))
+        rows.append(
+            summarise_row(
+                variant,
+                seeds,
+                None if paper is None else paper.paper_success(variant, run.choose_on or None),
+                _dataset_size(datasets[variant]),
+                label=variant_label(variant, run.derived),
+                paper_columns={c: paper.paper_success(variant, c) for c in run.columns},
+            )
+        )
+        if not trains_with_base(variant, run.derived):
+            rows[-1]["without_base"] = True  # trained on its own data alone, not D plus it
     ran = {step["step"] for step in run.commands}
     result = {
         "task": cfg.task,
         "name": cfg.name,
         "reveal": env.reveal.value,
+        **({"columns": run.columns, "choose_on": run.choose_on} if run.columns else {}),
         "config": asdict(cfg),
         "code": run.code,
         "step_code": {step: run.versions.get(step) for step in sorted(ran)},
@@ -381,10 +467,16 @@ def run_table(cfg: TableConfig) -> dict:
 
 
 def table_command(cfg: TableConfig) -> dict:
-    """``igen-table``: run the table and print it."""
+    """``igen-table``: run the table and print it (``--dry_run=true``: print its commands)."""
+    if cfg.dry_run:
+        for step in plan(cfg):
+            print(f"# {step['step']}\n{step['command']}")
+        return {}
     result = run_table(cfg)
     for row in result["rows"]:
         per_seed = ", ".join(f"{100 * s['test']['success_rate']:.0f}" for s in row["seeds"])
         print(f"{row['label']:>18}: {100 * row['success_rate']:5.1f}%  (seeds: {per_seed}; paper: {row['paper']})")
+        for column, summary in row.get("columns", {}).items():
+            print(f"{column:>24}: {100 * summary['success_rate']:5.1f}%  (paper: {summary['paper']})")
     print(f"Wrote {cfg.results} and {results_folder(Path(cfg.results)) / (cfg.name + '.json')}")
     return result

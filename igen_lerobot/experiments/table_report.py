@@ -153,24 +153,8 @@ def render_main_table(results: list[dict]) -> list[str]:
 def render_markdown(result: dict, notes: str = "") -> list[str]:
     """One table's section: the table, a reading of it, the protocol and the commands."""
     cfg = result["config"]
-    lines = [
-        f"## {_title(result)}",
-        "",
-        "| Variant | ours (paper) | 95% CI | test rate per seed | spread (sd) | validation, best checkpoint "
-        "| chosen steps | training data |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for row in result["rows"]:
-        low, high = row["ci95"]
-        paper = "–" if row["paper"] is None else f"{row['paper']}"
-        per_seed = " / ".join(_pct(s["test"]["success_rate"]) for s in row["seeds"])
-        steps = " / ".join(str(s["chosen_step"]) for s in row["seeds"])
-        data = f"{row['dataset']['episodes']} episodes, {row['dataset']['frames']} frames"
-        lines.append(
-            f"| {row['label']} | {_pct(row['success_rate'])}% ({paper}) | {_pct(low)}–{_pct(high)}% | {per_seed} | "
-            f"{_pct(row['min'])}–{_pct(row['max'])} ({_pct(row['std'])}) | {_pct(row['validation_rate'])}% | "
-            f"{steps} | {data} |"
-        )
+    lines = [f"## {_title(result)}", ""]
+    lines += _column_rows(result) if result.get("columns") else _rows(result)
     if notes.strip():
         lines += ["", notes.strip()]
     train = cfg["train"]
@@ -190,6 +174,8 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         f"- Checkpoint choice: {_which_checkpoints(cfg['eval_every'])} on {cfg['n_val_trials']} validation "
         f"trials from seed {cfg['val_seed']}; the rate reported is that checkpoint's on {cfg['n_trials']} "
         f"test trials from seed {cfg['test_seed']}. 95% CI: Wilson, on all seeds' test trials together.",
+        *_columns_line(result),
+        *_without_base_line(result),
         _code_line(result),
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
@@ -202,6 +188,73 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         "",
     ]
     return lines
+
+
+def _data(row: dict) -> str:
+    return f"{row['dataset']['episodes']} episodes, {row['dataset']['frames']} frames"
+
+
+def _cell(summary: dict) -> str:
+    """``ours% (paper), low–high%``: a mean test rate, the paper's number and the 95% interval."""
+    low, high = summary["ci95"]
+    paper = "–" if summary["paper"] is None else summary["paper"]
+    return f"{_pct(summary['success_rate'])}% ({paper}), {_pct(low)}–{_pct(high)}%"
+
+
+def _rows(result: dict) -> list[str]:
+    """A one-column table: each row's rate, interval, seeds, spread, validation, chosen steps and data."""
+    lines = [
+        "| Variant | ours (paper) | 95% CI | test rate per seed | spread (sd) | validation, best checkpoint "
+        "| chosen steps | training data |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for row in result["rows"]:
+        low, high = row["ci95"]
+        paper = "–" if row["paper"] is None else f"{row['paper']}"
+        per_seed = " / ".join(_pct(s["test"]["success_rate"]) for s in row["seeds"])
+        steps = " / ".join(str(s["chosen_step"]) for s in row["seeds"])
+        lines.append(
+            f"| {row['label']} | {_pct(row['success_rate'])}% ({paper}) | {_pct(low)}–{_pct(high)}% | {per_seed} | "
+            f"{_pct(row['min'])}–{_pct(row['max'])} ({_pct(row['std'])}) | {_pct(row['validation_rate'])}% | "
+            f"{steps} | {_data(row)} |"
+        )
+    return lines
+
+
+def _column_rows(result: dict) -> list[str]:
+    """A table with columns (Nut-and-Peg: one per geometry): a cell per column, ours (paper) and its interval."""
+    columns = list(result["columns"])
+    lines = [
+        f"| Variant | {' | '.join(columns)} | test rate per seed ({' ; '.join(columns)}) "
+        f"| validation ({result['choose_on']}), best checkpoint | chosen steps | training data |",
+        "|---|" + "---|" * (len(columns) + 4),
+    ]
+    for row in result["rows"]:
+        cells = " | ".join(_cell(row["columns"][c]) for c in columns)
+        per_seed = " ; ".join(" / ".join(_pct(s["columns"][c]["success_rate"]) for s in row["seeds"]) for c in columns)
+        steps = " / ".join(str(s["chosen_step"]) for s in row["seeds"])
+        lines.append(
+            f"| {row['label']} | {cells} | {per_seed} | {_pct(row['validation_rate'])}% | {steps} | {_data(row)} |"
+        )
+    return lines
+
+
+def _columns_line(result: dict) -> list[str]:
+    """The protocol's line on columns, for a table that has them."""
+    if not result.get("columns"):
+        return []
+    flags = "; ".join(f"{c}: `{' '.join(f)}`" for c, f in result["columns"].items())
+    return [
+        f"- Columns: every chosen checkpoint is tested in each column, under its env flags ({flags}), on "
+        f"its own {result['config']['n_trials']} test trials; the checkpoint is chosen on the "
+        f"{result['choose_on']} column's validation trials."
+    ]
+
+
+def _without_base_line(result: dict) -> list[str]:
+    """The protocol's line on rows trained without D (a table's own rows may be), where there are any."""
+    alone = [row["label"] for row in result["rows"] if row.get("without_base")]
+    return [f"- Trained on their own data alone, not D plus it: {', '.join(alone)}."] if alone else []
 
 
 def render_superseded(result: dict, notes: str = "") -> list[str]:
