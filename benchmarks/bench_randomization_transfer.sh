@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Does generating with a randomised arm make the Block Grasp I-Gen policy transfer better?
+# Takes a finished `igen-table --task=block_grasp --variants='[igen]' --train_seeds='[1000]'` run
+# (its 10 source demonstrations and interventions, its base policy, its I-Gen checkpoint) and makes
+# the same row again with only one change: D (1000 MimicGen demos) and the 1000 IntervenGen
+# episodes are generated with every --env.randomize.* flag on. Same sources, base policy, seeds,
+# training settings, validation and test trials. Then both I-Gen checkpoints go through
+# igen-eval (the training arm) and the rehearsal (bench_rehearsal.sh: the MuJoCo arm and franky on
+# franky-sim, the trials igen-eval runs with --compare_sim).
+#
+#   MUJOCO_GL=egl bash benchmarks/bench_randomization_transfer.sh outputs/bg_igen1 outputs/bg_igen_rand [TRIALS]
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
+out=${2:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
+trials=${3:-20}
+bin=.venv/bin
+randomize=(--env.randomize.kp_scale=[0.5,1.5] --env.randomize.latency=[0,0.04]
+  --env.randomize.hand_tilt_deg=3 --env.randomize.eef_pos_noise=0.001)
+base_policy="$table/train/base/seed1000/checkpoints/last/pretrained_model"
+mkdir -p "$out/data" "$out/eval"
+step() {  # name, done-marker, command...: skipped once its output is complete
+  local name=$1 done=$2; shift 2
+  [ -e "$done" ] && return
+  echo "$(date +%T) $name: $*"
+  "$@" > "$out/$name.log" 2>&1
+}
+step base "$out/data/base/meta/igen.json" "$bin/igen-generate" --mode=mimicgen --env.type=block_grasp "${randomize[@]}" \
+  --source.root="$table/data/source_demos" --num_episodes=1000 --seed=0 --workers=2 --dataset.root="$out/data/base"
+if [ ! -e "$table/data/source_int/meta/igen.json" ] || [ ! -e "$base_policy/config.json" ]; then
+  echo "$table has no source interventions or base policy yet: finish its igen-table run, then rerun this"; exit 1
+fi
+step igen "$out/data/igen/meta/igen.json" "$bin/igen-generate" --mode=igen --env.type=block_grasp "${randomize[@]}" \
+  --source.root="$table/data/source_int" --num_episodes=1000 --seed=4 --workers=2 --policy.path="$base_policy" \
+  --dataset.root="$out/data/igen"
+step merge "$out/data/train_igen/meta/igen.json" "$bin/igen-merge" --task=block_grasp \
+  "--inputs=[$out/data/base,$out/data/igen]" --dataset.root="$out/data/train_igen"
+step train "$out/train/igen/checkpoints/002000/pretrained_model/config.json" "$bin/lerobot-train" --policy.type=bc_rnn \
+  --policy.device=cpu --policy.push_to_hub=false --dataset.repo_id=local/train_igen \
+  --dataset.root="$out/data/train_igen" --output_dir="$out/train/igen" --steps=2000 --batch_size=100 --num_workers=2 \
+  --save_freq=500 --seed=1000 --wandb.enable=false
+step validate "$out/eval/validation.json" "$bin/igen-eval" --env.type=block_grasp --train_dir="$out/train/igen" \
+  --n_trials=20 --seed=1000003 --output="$out/eval/validation.json"
+chosen=$("$bin/python" -c "import json,sys; print(json.load(open(sys.argv[1]))['best']['step'])" "$out/eval/validation.json")
+checkpoint=$(printf '%s/train/igen/checkpoints/%06d/pretrained_model' "$out" "$chosen")
+step test "$out/eval/test.json" "$bin/igen-eval" --env.type=block_grasp --policy.path="$checkpoint" --n_trials=50 \
+  --seed=2000003 --output="$out/eval/test.json"
+plain=$("$bin/python" - "$table" <<'PY'
+import sys
+from igen_lerobot.experiments.table import chosen_checkpoint
+print(chosen_checkpoint(sys.argv[1], "igen", 1000)[1])
+PY
+)
+[ -e "$out/rehearsal_plain/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$plain" "$trials" "$out/rehearsal_plain"
+[ -e "$out/rehearsal_randomised/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$checkpoint" "$trials" "$out/rehearsal_randomised"
+echo "plain I-Gen ($plain):"
+"$bin/python" benchmarks/rehearsal_summary.py "$out/rehearsal_plain/mujoco.json" "$out/rehearsal_plain/franky.json"
+echo "randomised I-Gen ($checkpoint), test trials: $("$bin/python" -c "import json,sys; b=json.load(open(sys.argv[1]))['best']; print(b['successes'], '/', b['trials'])" "$out/eval/test.json")"
+"$bin/python" benchmarks/rehearsal_summary.py "$out/rehearsal_randomised/mujoco.json" "$out/rehearsal_randomised/franky.json"
