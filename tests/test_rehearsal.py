@@ -205,7 +205,7 @@ def test_the_page_renders_a_rehearsal_beside_the_papers_columns_with_the_orderin
     assert f"- {PATHS['rendered']}: holds (strictly increasing)." in page
     assert f"- {PATHS['franky']}: does not hold (MG Demo and I-Gen − Policy equal)." in page
     assert "A reading." in page
-    assert "- Code: steps ran at aaaaaaaaaa" in page
+    assert "- Code: every step ran at commit aaaaaaaaaa." in page
 
 
 def test_the_ordering_rule_names_inversions_and_skips_a_path_some_row_lacks():

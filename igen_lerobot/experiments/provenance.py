@@ -70,3 +70,35 @@ def provenance_problems(result: dict) -> list[str]:
         missing = sorted(fields - set(config or {}))
         problems.append(f"config is not a whole {config_class.__name__} (missing {missing})")
     return problems
+
+
+def code_line(result: dict) -> str:
+    """Which commits made the table's steps: one, or each with the steps it made."""
+    by_commit: dict[str, list[str]] = {}
+    for step, code in result.get("step_code", {}).items():
+        key = (
+            "unrecorded"
+            if not code or not code.get("commit")
+            else code["commit"][:10] + (" + uncommitted changes" if code.get("dirty") else "")
+        )
+        by_commit.setdefault(key, []).append(step)
+    if len(by_commit) == 1:
+        return f"- Code: every step ran at commit {next(iter(by_commit))}."
+    parts = "; ".join(f"{commit}: {len(steps)} steps" for commit, steps in sorted(by_commit.items()))
+    return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
+
+
+def provenance_lines(result: dict) -> list[str]:
+    """How a recorded run was made: its code versions, its wall time and every command, as the page shows them."""
+    return [
+        code_line(result),
+        f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
+        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
+        "",
+        "Commands:",
+        "",
+        "```bash",
+        *[c["command"] for c in result["commands"]],
+        "```",
+        "",
+    ]

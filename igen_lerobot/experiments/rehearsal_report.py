@@ -7,6 +7,8 @@ real-robot columns; then, per path, whether the rows keep the order of the paper
 
 from __future__ import annotations
 
+from igen_lerobot.experiments.provenance import provenance_lines
+
 KIND = "rehearsal"  # the ``kind`` of a rehearsal JSON in the results folder (tables have none)
 
 
@@ -96,21 +98,5 @@ def render_rehearsal(result: dict, notes: str = "") -> list[str]:
     ]
     if notes.strip():
         lines += ["", notes.strip()]
-    codes = {
-        "unrecorded" if not c or not c.get("commit") else c["commit"][:10] + (" + uncommitted" if c["dirty"] else "")
-        for c in result["step_code"].values()
-    }
-    lines += [
-        "",
-        f"- Code: steps ran at {', '.join(sorted(codes))} (per step in the JSON).",
-        f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
-        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
-        "",
-        "Commands:",
-        "",
-        "```bash",
-        *[c["command"] for c in result["commands"]],
-        "```",
-        "",
-    ]
+    lines += ["", *provenance_lines(result)]
     return lines

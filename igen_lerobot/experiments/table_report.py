@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from igen_lerobot.core.paper import VARIANTS
+from igen_lerobot.experiments.provenance import provenance_lines
 from igen_lerobot.experiments.rehearsal_report import is_rehearsal, render_rehearsal
 
 SUPERSEDED = "superseded"  # subfolder of tables kept for the record: one seed, checkpoint chosen on the reported trials
@@ -62,22 +63,6 @@ def _title(result: dict) -> str:
 
 def _pct(rate: float) -> str:
     return f"{100 * rate:.0f}"
-
-
-def _code_line(result: dict) -> str:
-    """Which commits made the table's steps: one, or each with the steps it made."""
-    by_commit: dict[str, list[str]] = {}
-    for step, code in result.get("step_code", {}).items():
-        key = (
-            "unrecorded"
-            if not code or not code.get("commit")
-            else code["commit"][:10] + (" + uncommitted changes" if code.get("dirty") else "")
-        )
-        by_commit.setdefault(key, []).append(step)
-    if len(by_commit) == 1:
-        return f"- Code: every step ran at commit {next(iter(by_commit))}."
-    parts = "; ".join(f"{commit}: {len(steps)} steps" for commit, steps in sorted(by_commit.items()))
-    return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
 
 
 def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str]] = (), study: str = "") -> str:
@@ -176,16 +161,7 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         f"test trials from seed {cfg['test_seed']}. 95% CI: Wilson, on all seeds' test trials together.",
         *_columns_line(result),
         *_without_base_line(result),
-        _code_line(result),
-        f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
-        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
-        "",
-        "Commands:",
-        "",
-        "```bash",
-        *[c["command"] for c in result["commands"]],
-        "```",
-        "",
+        *provenance_lines(result),
     ]
     return lines
 
