@@ -16,18 +16,12 @@ mkdir -p "$out"
   --dataset.root="$out/demos" >/dev/null 2>&1
 [ -e "$out/interventions" ] || "$bin/igen-collect" --env.type=block_grasp --mode=interventions --num_episodes=10 \
   --seed=1 --dataset.root="$out/interventions" >/dev/null 2>&1
-declare -A settings=(
-  [none]=""
-  [kp_0.5-1.5]="--env.randomize.kp_scale=[0.5,1.5]"
-  [latency_0-40ms]="--env.randomize.latency=[0,0.04]"
-  [tilt_3deg]="--env.randomize.hand_tilt_deg=3"
-  [noise_1mm]="--env.randomize.eef_pos_noise=0.001"
-)
-for name in none kp_0.5-1.5 latency_0-40ms tilt_3deg noise_1mm; do
+source benchmarks/randomization_settings.sh
+for name in "${RANDOMIZE_ORDER[@]:0:5}"; do  # none, then each flag alone
   for mode in mimicgen igen; do
     source=$([ "$mode" = mimicgen ] && echo demos || echo interventions)
     root="$out/${name}_${mode}"
-    [ -e "$root" ] || "$bin/igen-generate" --env.type=block_grasp ${settings[$name]} --mode="$mode" --seed=7 \
+    [ -e "$root" ] || "$bin/igen-generate" --env.type=block_grasp ${RANDOMIZE_SETTINGS[$name]} --mode="$mode" --seed=7 \
       --source.root="$out/$source" --num_episodes="$episodes" --max_attempts=$((episodes * 5)) --workers=2 \
       --dataset.root="$root" >/dev/null 2>&1
     "$bin/python" - "$root" "$name" "$mode" <<'PY'

@@ -11,17 +11,10 @@ trials=${2:-50}
 out=${3:-outputs/bench_randomization_eval}
 seed=${4:-2000003}  # igen-table's test trials (held out from every checkpoint choice)
 mkdir -p "$out"
-declare -A settings=(
-  [none]=""
-  [kp_0.5-1.5]="--env.randomize.kp_scale=[0.5,1.5]"
-  [latency_0-40ms]="--env.randomize.latency=[0,0.04]"
-  [tilt_3deg]="--env.randomize.hand_tilt_deg=3"
-  [noise_1mm]="--env.randomize.eef_pos_noise=0.001"
-  [all]="--env.randomize.kp_scale=[0.5,1.5] --env.randomize.latency=[0,0.04] --env.randomize.hand_tilt_deg=3 --env.randomize.eef_pos_noise=0.001"
-)
-for name in none kp_0.5-1.5 latency_0-40ms tilt_3deg noise_1mm all; do
+source benchmarks/randomization_settings.sh
+for name in "${RANDOMIZE_ORDER[@]}"; do
   report="$out/$name.json"
-  [ -e "$report" ] || .venv/bin/igen-eval --env.type=block_grasp ${settings[$name]} --policy.path="$checkpoint" \
+  [ -e "$report" ] || .venv/bin/igen-eval --env.type=block_grasp ${RANDOMIZE_SETTINGS[$name]} --policy.path="$checkpoint" \
     --n_trials="$trials" --seed="$seed" --output="$report" >/dev/null 2>&1
   .venv/bin/python - "$report" "$name" <<'PY'
 import json, sys

@@ -15,8 +15,8 @@ table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
 out=${2:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
 trials=${3:-20}
 bin=.venv/bin
-randomize=(--env.randomize.kp_scale=[0.5,1.5] --env.randomize.latency=[0,0.04]
-  --env.randomize.hand_tilt_deg=3 --env.randomize.eef_pos_noise=0.001)
+source benchmarks/randomization_settings.sh
+randomize=("${RANDOMIZE_ALL[@]}")
 base_policy="$table/train/base/seed1000/checkpoints/last/pretrained_model"
 mkdir -p "$out/data" "$out/eval"
 step() {  # name, done-marker, command...: skipped once its output is complete
