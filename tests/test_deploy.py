@@ -578,3 +578,35 @@ def test_nut_insertion_rehearses_on_the_mujoco_arm_with_7d_actions():
     assert all(t["revealed_at"] is not None for t in report["per_trial"])  # the nut-peg contact was felt
     with pytest.raises(ConfigError, match="perception.type=truth"):
         deploy(DeployConfig(task="nut_insertion", robot=SimArmBackendConfig(), trials=1))
+
+
+@pytest.mark.parametrize("task", ["nut_insertion", "coffee"])
+def test_the_simulated_arm_homes_where_its_tasks_episodes_start(task):
+    """move_home goes to the task's own start pose (position and orientation), not Block Grasp's.
+
+    Tolerance: 5 mm, move_home's own settling bound; orientation within 2 degrees.
+    """
+    from igen_lerobot.core.env_config import task_config_class
+
+    arm = MujocoArm(env_config=task_config_class(task)())
+    arm.connect()
+    try:
+        start = arm.read_state().T_base_eef
+        block_grasp = MujocoArm()
+        block_grasp.connect()
+        block_grasp_home = block_grasp.read_state().T_base_eef[:3, 3]
+        block_grasp.disconnect()
+        assert np.linalg.norm(start[:3, 3] - block_grasp_home) > 0.01  # the homes differ: the test can tell them apart
+        away = start.copy()
+        away[:3, 3] += (0.04, -0.03, 0.03)
+        arm.send_target(away)
+        for _ in range(30):
+            arm.sync(1.0 / arm.config.fps)
+        assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - start[:3, 3]) > 0.02
+        arm.move_home()
+        home = arm.read_state()
+        assert np.linalg.norm(home.T_base_eef[:3, 3] - start[:3, 3]) < 0.005
+        cos = (np.trace(home.T_base_eef[:3, :3].T @ start[:3, :3]) - 1) / 2
+        assert np.degrees(np.arccos(np.clip(cos, -1, 1))) < 2.0
+    finally:
+        arm.disconnect()

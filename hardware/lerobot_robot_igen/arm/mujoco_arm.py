@@ -45,6 +45,7 @@ class MujocoArm(ArmDriver):
         self.env = None
         self._follows_rotation = False
         self._target_world: np.ndarray | None = None
+        self._home_world: np.ndarray | None = None  # where the task's episodes start the hand (set on connect)
         self._gripper_closed = False
         self._force = 0.0
 
@@ -62,6 +63,7 @@ class MujocoArm(ArmDriver):
             self.env = env_config.make_task_env()
             self._follows_rotation = isinstance(self.env.action_space, DeltaPoseActions)
             self.reset_scene(0)
+            self._home_world = self.env.eef_pose()  # each task homes where its own episodes start
             base = mujoco.mj_name2id(self.env.model, mujoco.mjtObj.mjOBJ_BODY, "robot0_base")
             self._world_from_base = np.eye(4)
             self._world_from_base[:3, :3] = self.env.data.xmat[base].reshape(3, 3)
@@ -139,11 +141,9 @@ class MujocoArm(ArmDriver):
         self._env()
 
     def move_home(self) -> None:
-        from lerobot_env_igen.block_grasp.env import HOME_EEF_POS
-
+        """To the task's start pose (position and orientation), gripper open, within ``home_steps`` periods."""
         env = self._env()
-        home = env.eef_pose()
-        home[:3, 3] = HOME_EEF_POS
+        home = self._home_world.copy()
         self._target_world = home
         self._gripper_closed = False
         for _ in range(self.config.home_steps):
