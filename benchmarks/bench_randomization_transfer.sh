@@ -3,20 +3,26 @@
 # Takes a finished `igen-table --task=block_grasp --variants='[igen]' --train_seeds='[1000]'` run
 # (its 10 source demonstrations and interventions, its base policy, its I-Gen checkpoint) and makes
 # the same row again with only one change: D (1000 MimicGen demos) and the 1000 IntervenGen
-# episodes are generated with every --env.randomize.* flag on. Same sources, base policy, seeds,
+# episodes are generated with the randomisation SETTING on (a name in randomization_settings.sh:
+# `all`, the default, or one flag alone, e.g. `kp_0.5-1.5`). Same sources, base policy, seeds,
 # training settings, validation and test trials. Then both I-Gen checkpoints go through
 # igen-eval (the training arm) and the rehearsal (bench_rehearsal.sh: the MuJoCo arm and franky on
 # franky-sim, the trials igen-eval runs with --compare_sim).
 #
-#   MUJOCO_GL=egl bash benchmarks/bench_randomization_transfer.sh outputs/bg_igen1 outputs/bg_igen_rand [TRIALS]
+#   MUJOCO_GL=egl bash benchmarks/bench_randomization_transfer.sh outputs/bg_igen1 outputs/bg_igen_rand [TRIALS] [SETTING]
+# The table's own I-Gen checkpoint is rehearsed once, into TABLE_DIR/rehearsal_igen, and reused by every setting.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
 out=${2:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
 trials=${3:-20}
+setting=${4:-all}
 bin=.venv/bin
 source benchmarks/randomization_settings.sh
-randomize=("${RANDOMIZE_ALL[@]}")
+[ -n "${RANDOMIZE_SETTINGS[$setting]+set}" ] && [ "$setting" != none ] \
+  || { echo "SETTING must be one of ${RANDOMIZE_ORDER[*]:1}, got '$setting'"; exit 2; }
+read -r -a randomize <<< "${RANDOMIZE_SETTINGS[$setting]}"
+echo "$(date +%T) $out: generation randomised with ${randomize[*]}"
 base_policy="$table/train/base/seed1000/checkpoints/last/pretrained_model"
 mkdir -p "$out/data" "$out/eval"
 step() {  # name, done-marker, command...: skipped once its output is complete
@@ -51,9 +57,10 @@ from igen_lerobot.experiments.table import chosen_checkpoint
 print(chosen_checkpoint(sys.argv[1], "igen", 1000)[1])
 PY
 )
-[ -e "$out/rehearsal_plain/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$plain" "$trials" "$out/rehearsal_plain"
+plain_rehearsal=$table/rehearsal_igen  # the table's own checkpoint: rehearsed once, whatever the setting
+[ -e "$plain_rehearsal/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$plain" "$trials" "$plain_rehearsal"
 [ -e "$out/rehearsal_randomised/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$checkpoint" "$trials" "$out/rehearsal_randomised"
 echo "plain I-Gen ($plain):"
-"$bin/python" benchmarks/rehearsal_summary.py "$out/rehearsal_plain/mujoco.json" "$out/rehearsal_plain/franky.json"
+"$bin/python" benchmarks/rehearsal_summary.py "$plain_rehearsal/mujoco.json" "$plain_rehearsal/franky.json"
 echo "randomised I-Gen ($checkpoint), test trials: $("$bin/python" -c "import json,sys; b=json.load(open(sys.argv[1]))['best']; print(b['successes'], '/', b['trials'])" "$out/eval/test.json")"
 "$bin/python" benchmarks/rehearsal_summary.py "$out/rehearsal_randomised/mujoco.json" "$out/rehearsal_randomised/franky.json"
