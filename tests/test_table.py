@@ -261,3 +261,44 @@ def test_the_main_table_across_tasks_has_a_column_per_task_with_all_seven_rows()
     assert lines[13] == "| I-Gen | 70% (60), 60–80% | 70% (–), 60–80% |" and len(lines) == 15
     assert render_main_table([nut, *others]) == []  # one task: its own table says it all
     assert render_main_table(others) == []
+
+
+def test_randomised_generation_reaches_the_generators_only_and_names_its_own_table(tmp_path):
+    """--randomize: generation as domain randomisation. Every igen-generate step (D and each generated
+    row) gets the flags; sources are collected, and every policy evaluated, on the task's own arm;
+    the table is saved under its own name, so it never replaces the plain one; bad flags name the fix."""
+    from igen_lerobot.core.exceptions import ConfigError
+    from igen_lerobot.experiments.table import plan
+
+    flags = ["--env.randomize.kp_scale=[0.5,1.5]", "--env.randomize.latency=[0,0.04]"]
+    cfg = TableConfig(variants=["mg_demo", "igen"], randomize=flags, output_dir=str(tmp_path / "t"), dry_run=True)
+    assert cfg.name == "block_grasp_randomized" and TableConfig().name == "block_grasp"
+    steps = plan(cfg)
+    tools = {s["step"]: s["command"].split()[0] for s in steps}
+    randomised = {s["step"] for s in steps if all(f in s["command"].replace("'", "") for f in flags)}
+    assert randomised == {s for s, tool in tools.items() if tool == "igen-generate"}
+    assert {"base", "mg_test_demos", "igen"} <= randomised  # D, MG Demo's and I-Gen's data
+    assert not any("randomize" in s["command"] for s in steps if tools[s["step"]] != "igen-generate")
+    assert any(tools[s] == "igen-eval" for s in tools) and any(tools[s] == "igen-collect" for s in tools)
+    with pytest.raises(ConfigError, match=r"--env.randomize.\* flags only"):
+        TableConfig(randomize=["--env.max_delta=0.1"])
+    with pytest.raises(ConfigError, match="no block_grasp arm randomisation; it has .*kp_scale"):
+        TableConfig(randomize=["--env.randomize.stiffness=2"])
+    with pytest.raises(ConfigError, match=r"latency=\[0.0, 0.5\].*one control period"):
+        TableConfig(randomize=["--env.randomize.latency=[0,0.5]"])
+    with pytest.raises(ConfigError, match="position-only tasks"):  # the hand's tilt is a 6-DOF task's own action
+        TableConfig(task="nut_insertion", randomize=["--env.randomize.hand_tilt_deg=2"])
+    # its section says so, and it stays out of the main table across tasks
+    from igen_lerobot.experiments import table_report
+
+    result = {"task": "nut_insertion", "reveal": "full", "rows": [{"variant": v} for v in VARIANTS]}
+    result["config"] = asdict(TableConfig(task="nut_insertion"))
+    assert table_report.is_main_table(result) and not table_report._randomize_line(result["config"])
+    result["config"] = asdict(TableConfig(task="nut_insertion", randomize=flags))
+    title = table_report._title(result)
+    assert title == "Nut Insertion (full observability on contact), generated on randomised arms"
+    assert (
+        "`--env.randomize.kp_scale=[0.5,1.5] --env.randomize.latency=[0,0.04]`"
+        in table_report._randomize_line(result["config"])[0]
+    )
+    assert not table_report.is_main_table(result)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.env_config import TaskEnvConfig, task_config_class
@@ -41,6 +41,10 @@ class TableConfig:
     generated: int = 1000  # synthetic episodes for MG Demo, I-Gen - Policy and I-Gen
     workers: int = 2
     seed: int = 0
+    # generation as domain randomisation: --env.randomize.* flags for every igen-generate step (D and each
+    # generated row's data); sources are collected, and every policy evaluated, on the task's own arm.
+    # Quote each flag: --randomize='["--env.randomize.kp_scale=[0.5,1.5]","--env.randomize.latency=[0,0.04]"]'
+    randomize: list[str] = field(default_factory=list)
     train: TrainConfig = field(default_factory=lambda: TrainConfig(steps=2000, save_freq=500))
     train_seeds: list[int] | None = None  # default: train.seed and the two after it; given, its first is train.seed
     eval_every: int = 1  # validate every k-th saved checkpoint (the last always), test the best
@@ -83,6 +87,7 @@ class TableConfig:
         for name in ("source_episodes", "base_demos", "generated", "workers", "n_trials", "n_val_trials", "eval_every"):
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
+        self.check_randomize()
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")
 
@@ -97,6 +102,31 @@ class TableConfig:
             modes = [r.value for r in Reveal]
             raise ConfigError(f"--reveal={self.reveal!r} is not a reveal mode; use one of {modes}") from None
         return cls(reveal=reveal)
+
+    def check_randomize(self) -> None:
+        """Refuse a --randomize flag the task's env config would refuse, before hours of table run on it."""
+        import draccus
+
+        if not self.randomize:
+            return
+        bad = [flag for flag in self.randomize if not flag.startswith("--env.randomize.")]
+        if bad:
+            raise ConfigError(
+                f"--randomize takes --env.randomize.* flags only (the arm randomisation of generation), got {bad}"
+            )
+        cls = task_config_class(self.task)
+        if "randomize" not in {f.name for f in fields(cls)}:
+            raise ConfigError(f"--randomize: task {self.task!r} has no arm randomisation (no --env.randomize)")
+        known = {f"--env.randomize.{f.name}" for f in fields(cls.__dataclass_fields__["randomize"].default_factory())}
+        unknown = [flag for flag in self.randomize if flag.split("=", 1)[0] not in known]
+        if unknown:
+            raise ConfigError(f"--randomize: {unknown} are no {self.task} arm randomisation; it has {sorted(known)}")
+        try:
+            draccus.parse(config_class=cls, args=[flag.replace("--env.", "--", 1) for flag in self.randomize])
+        except Exception as error:  # the env config's own check of a range, by its flag (draccus wraps it)
+            while error.__cause__ is not None or error.__context__ is not None:
+                error = error.__cause__ or error.__context__
+            raise ConfigError(f"--randomize={self.randomize} is refused by the {self.task} env: {error}") from None
 
     def paper_table(self) -> PaperTable | None:
         """The paper's table this run reproduces (checked: a clear error for an unknown --table)."""
@@ -117,4 +147,5 @@ class TableConfig:
         default = task_config_class(self.task)().reveal
         reveal = self.env_config().reveal
         name = self.task if reveal is default else f"{self.task}_{reveal.value}"
-        return f"{name}_{self.table}" if self.table else name
+        name = f"{name}_{self.table}" if self.table else name
+        return f"{name}_randomized" if self.randomize else name

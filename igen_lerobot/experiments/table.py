@@ -199,9 +199,10 @@ def check_resumed_config(cfg: TableConfig) -> None:
 
 def build_step(run: TableRun, step: DataStep, policy: str) -> None:
     """Make one dataset of the table of steps (skipped when it is complete)."""
+    env = env_args(run.cfg) + (run.cfg.randomize if step.tool == "igen-generate" else [])
     run.run(
         step.name,
-        run.igen(step.tool, *step.command(run.cfg, run.data, env_args(run.cfg), policy)),
+        run.igen(step.tool, *step.command(run.cfg, run.data, env, policy)),
         _complete(run.data(step.name)),
     )
 

@@ -58,7 +58,8 @@ def _title(result: dict) -> str:
         "direction": "partial observability: direction to the true pose",
     }.get(reveal, reveal)
     table = result.get("config", {}).get("table")  # a named table of the task, e.g. scaling
-    return f"{task} ({observability}), {table} table" if table else f"{task} ({observability})"
+    title = f"{task} ({observability}), {table} table" if table else f"{task} ({observability})"
+    return f"{title}, generated on randomised arms" if result.get("config", {}).get("randomize") else title
 
 
 def _pct(rate: float) -> str:
@@ -105,7 +106,13 @@ def render_page(tables: list[tuple[dict, str]], superseded: list[tuple[dict, str
 def is_main_table(result: dict) -> bool:
     """The paper's main-table shape: all seven variants, full observability, not a named table."""
     variants = {row["variant"] for row in result["rows"]}
-    return set(VARIANTS) <= variants and result.get("reveal") == "full" and not result["config"].get("table")
+    cfg = result["config"]
+    return (
+        set(VARIANTS) <= variants
+        and result.get("reveal") == "full"
+        and not cfg.get("table")
+        and not cfg.get("randomize")
+    )
 
 
 def render_main_table(results: list[dict]) -> list[str]:
@@ -151,6 +158,7 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         f"- {cfg['source_episodes']} source episodes of each kind (scripted operator), "
         f"{cfg['base_demos']} MimicGen demonstrations in D, "
         f"{cfg['generated']} generated episodes per generated variant.",
+        *_randomize_line(cfg),
         f"- `lerobot-train --policy.type={train['policy_type']}`:{extra} "
         f"{train['steps']} steps × batch {train['batch_size']}, "
         f"checkpoint every {train['save_freq'] or train['steps']} steps, device {train['device']}, "
@@ -164,6 +172,16 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         *provenance_lines(result),
     ]
     return lines
+
+
+def _randomize_line(cfg: dict) -> list[str]:
+    if not cfg.get("randomize"):
+        return []
+    flags = " ".join(cfg["randomize"])
+    return [
+        f"- Generated on randomised arms (D and every generated row's data): `{flags}`; sources collected, "
+        "and every policy evaluated, on the task's own arm."
+    ]
 
 
 def _data(row: dict) -> str:
