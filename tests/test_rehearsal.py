@@ -206,6 +206,10 @@ def test_the_page_renders_a_rehearsal_beside_the_papers_columns_with_the_orderin
     assert f"- {PATHS['franky']}: does not hold (MG Demo and I-Gen − Policy equal)." in page
     assert "A reading." in page
     assert "- Code: every step ran at commit aaaaaaaaaa." in page
+    # a table generated on randomised arms (igen-table --randomize) says so in its rehearsal's title
+    result["table"] = {"randomize": ["--env.randomize.latency=[0,0.04]"]}
+    page = render_page([(result, "")])
+    assert "## Block Grasp rehearsal, generated on randomised arms (`--env.randomize.latency=[0,0.04]`): the" in page
 
 
 def test_the_ordering_rule_names_inversions_and_skips_a_path_some_row_lacks():

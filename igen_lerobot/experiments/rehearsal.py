@@ -207,13 +207,19 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
             }
         )
     ran = {step["step"] for step in runner.commands}
-    name = f"{TASK}_rehearsal"
+    randomize = table.get("randomize") or []  # a table generated on randomised arms is rehearsed under its own name
+    name = f"{TASK}_randomized_rehearsal" if randomize else f"{TASK}_rehearsal"
     result = {
         "kind": KIND,
         "task": TASK,
         "name": name,
         "config": asdict(cfg),
-        "table": {"dir": settings["table_dir"], "train_seeds": table["train_seeds"], "test_seed": table["test_seed"]},
+        "table": {
+            "dir": settings["table_dir"],
+            "train_seeds": table["train_seeds"],
+            "test_seed": table["test_seed"],
+            "randomize": randomize,
+        },
         "seed": settings["seed"],
         "checkpoint_choice": choice,
         "trial_seed": settings["trial_seed"],

@@ -70,8 +70,11 @@ def render_rehearsal(result: dict, notes: str = "") -> list[str]:
     paths = list(result["paths"])
     labels = {row["variant"]: row["label"] for row in result["rows"]}
     paper = result["paper"]
+    randomize = result.get("table", {}).get("randomize")
+    generated = f", generated on randomised arms (`{' '.join(randomize)}`)" if randomize else ""
     lines = [
-        f"## {result['task'].replace('_', ' ').title()} rehearsal: the sim-to-real rows through the deployment paths",
+        f"## {result['task'].replace('_', ' ').title()} rehearsal{generated}: the sim-to-real rows through the "
+        "deployment paths",
         "",
         f"Each row's checkpoint is {result['checkpoint_choice']}. Every path runs the same "
         f"{result['trials']} trials, {result['trial_choice']}, episodes of at most {result['max_steps']} steps; "
