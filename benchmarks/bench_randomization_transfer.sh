@@ -10,7 +10,9 @@
 # franky-sim, the trials igen-eval runs with --compare_sim).
 #
 #   MUJOCO_GL=egl bash benchmarks/bench_randomization_transfer.sh outputs/bg_igen1 outputs/bg_igen_rand [TRIALS] [SETTING]
-# The table's own I-Gen checkpoint is rehearsed once, into TABLE_DIR/rehearsal_igen, and reused by every setting.
+# The table's own I-Gen checkpoint is rehearsed once per pace clock, into TABLE_DIR/rehearsal_igen_<pace>, and
+# reused by every setting. PACE_ON=arm|wall (default arm): the clock franky's 20 Hz periods are measured on
+# (igen-deploy --pace_on); franky-sim's own runs slower than the wall clock.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
@@ -57,10 +59,13 @@ from igen_lerobot.experiments.table import chosen_checkpoint
 print(chosen_checkpoint(sys.argv[1], "igen", 1000)[1])
 PY
 )
-plain_rehearsal=$table/rehearsal_igen  # the table's own checkpoint: rehearsed once, whatever the setting
-[ -e "$plain_rehearsal/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$plain" "$trials" "$plain_rehearsal"
-[ -e "$out/rehearsal_randomised/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$checkpoint" "$trials" "$out/rehearsal_randomised"
+pace=${PACE_ON:-arm}
+plain_rehearsal=$table/rehearsal_igen_$pace  # the table's own checkpoint: rehearsed once, whatever the setting
+randomised_rehearsal=$out/rehearsal_randomised_$pace
+[ -e "$plain_rehearsal/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$plain" "$trials" "$plain_rehearsal" --pace_on="$pace"
+[ -e "$randomised_rehearsal/franky.json" ] \
+  || bash benchmarks/bench_rehearsal.sh "$checkpoint" "$trials" "$randomised_rehearsal" --pace_on="$pace"
 echo "plain I-Gen ($plain):"
 "$bin/python" benchmarks/rehearsal_summary.py "$plain_rehearsal/mujoco.json" "$plain_rehearsal/franky.json"
 echo "randomised I-Gen ($checkpoint), test trials: $("$bin/python" -c "import json,sys; b=json.load(open(sys.argv[1]))['best']; print(b['successes'], '/', b['trials'])" "$out/eval/test.json")"
-"$bin/python" benchmarks/rehearsal_summary.py "$out/rehearsal_randomised/mujoco.json" "$out/rehearsal_randomised/franky.json"
+"$bin/python" benchmarks/rehearsal_summary.py "$randomised_rehearsal/mujoco.json" "$randomised_rehearsal/franky.json"

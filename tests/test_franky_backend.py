@@ -426,6 +426,12 @@ def test_igen_deploy_rehearses_igen_evals_trials_through_franky_on_franky_sim():
     # franky-sim raises no reflexes; any stop is the safety layer's, with its reason
     assert all("reflex" not in str(trial["fault"]) for trial in report["per_trial"]), report["per_trial"]
     assert report["sim"]["successes"] >= 0 and len(report["per_trial_sim"]) == 2
+    # the periods are the arm's (--pace_on=arm, the default): 50 ms of libfranka's robot time each,
+    # however fast franky-sim's clock runs against the wall clock (tolerance 15%)
+    rate = report["pace"]["arm_seconds_per_wall_second"]
+    assert report["pace"]["clock"] == "arm" and 0.2 < rate < 1.1, report["pace"]
+    arm_period = report["loop"]["period"]["median_ms"] * rate
+    assert 42.5 < arm_period < 57.5, (arm_period, report["loop"]["period"], rate)
 
 
 def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(empty_sim):

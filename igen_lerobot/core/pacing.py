@@ -3,21 +3,51 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
+
+from igen_lerobot.core.exceptions import IgenError
+
+
+class ClockStalledError(IgenError, TimeoutError):
+    """The clock a loop is paced on stopped advancing (an arm that no longer reports its time)."""
 
 
 class RatePacer:
-    """Keeps a loop at ``hz`` when a person is in it (``None``: as fast as possible)."""
+    """Keeps a loop at ``hz`` when a person or a robot is in it (``None``: as fast as possible).
 
-    def __init__(self, hz: float | None) -> None:
+    ``clock``: the clock whose periods count (default: the wall clock). A robot's own clock
+    (libfranka's robot time) makes a period the arm's 50 ms even where a simulator behind the
+    protocol runs slower than real time; it is polled, and a clock that stands still for
+    ``stall_timeout`` seconds of wall time raises :class:`ClockStalledError` instead of hanging the loop.
+    A late tick is not made up with a burst of short periods: the next period starts from it.
+    """
+
+    def __init__(self, hz: float | None, clock: Callable[[], float] | None = None, stall_timeout: float = 1.0) -> None:
         self.period = None if not hz else 1.0 / hz
-        self._next = time.perf_counter()
+        self.clock = clock
+        self.stall_timeout = stall_timeout
+        self._next = (clock or time.perf_counter)() if self.period is not None else 0.0
 
     def wait(self) -> None:
         if self.period is None:
             return
         self._next += self.period
-        delay = self._next - time.perf_counter()
-        if delay > 0:
-            time.sleep(delay)
-        else:
-            self._next = time.perf_counter()
+        if self.clock is None:
+            delay = self._next - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+            else:
+                self._next = time.perf_counter()
+            return
+        deadline = time.perf_counter() + self.stall_timeout
+        now = self.clock()
+        if now >= self._next:
+            self._next = now
+            return
+        while now < self._next:
+            if time.perf_counter() > deadline:
+                raise ClockStalledError(
+                    f"the loop's clock stood at {now:.3f} s for {self.stall_timeout} s of wall time"
+                )
+            time.sleep(min(self._next - now, 0.001))
+            now = self.clock()

@@ -102,6 +102,14 @@ class ArmDriver(abc.ABC):
 
         return time.monotonic()
 
+    def robot_time(self) -> float | None:
+        """The arm's own clock [s] where it reports one (libfranka's robot time), else None.
+
+        On a real arm it runs with the wall clock; a simulator behind the arm's protocol may run
+        slower (franky-sim's Python 1 kHz loop), and a loop paced on it still gives the arm its periods.
+        """
+        return None
+
     def sync(self, period: float) -> None:  # noqa: B027 - real arms move on their own
         """Let one control period pass. Real arms move on their own; simulated ones step here."""
 

@@ -169,6 +169,10 @@ class FrankyArm(ArmDriver):
         return self.robot is not None
 
     # ------------------------------------------------------------------ state
+    def robot_time(self) -> float:
+        """The arm's own clock [s]: libfranka's robot time, the time stamp of its last state."""
+        return float(self._call("a state read", lambda: self.robot.state.time.to_sec()))
+
     def read_state(self) -> ArmState:
         robot = self.robot
         pose = self._call("a state read", lambda: robot.current_cartesian_state.pose.end_effector_pose)

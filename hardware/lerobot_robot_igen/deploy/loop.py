@@ -61,7 +61,10 @@ class LoopSettings:
     max_steps: int = 200
     contact_force_threshold: float = 2.0  # [N] external force that counts as touching the cube
     max_pose_age: float = 0.5  # [s] act on a previous cube estimate for at most this long
-    realtime: bool = True  # pace to the wall clock (real arms); False: as fast as the sim steps
+    realtime: bool = True  # pace to real time (real arms); False: as fast as the sim steps
+    # the clock whose periods the loop paces on when realtime (None: the wall clock): the arm's own
+    # (DeployConfig.pace_on=arm), so that an arm simulated slower than real time still gets its periods
+    pace_clock: Callable[[], float] | None = None
     pose_gate: PoseGateSettings = field(default_factory=PoseGateSettings)
     # the hand orientation the policy observes (task frame) instead of the measured one; None: measured
     observed_hand_rotation: np.ndarray | None = None
@@ -101,6 +104,9 @@ class EpisodeOutcome:
     rejected_jumps: int = 0  # estimates further than the cube could have moved
     pose_rejections: list[dict] = field(default_factory=list)  # {step, kind, reason}, the first MAX_LOGGED
     clamped_targets: int = 0
+    # seconds of the loop's pace clock per second of wall time over the episode (None: paced on the wall
+    # clock, or not in real time): a real arm's is 1; franky-sim's Python loop runs slower
+    pace_clock_rate: float | None = None
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -147,7 +153,9 @@ def run_episode(
     layout = ActionLayout.of(spec.action_names)
     period = 1.0 / settings.fps
     max_stale = settings.max_pose_age
-    pacer = RatePacer(settings.fps if settings.realtime else None)
+    pacer = RatePacer(settings.fps if settings.realtime else None, clock=settings.pace_clock)
+    paced_on_clock = settings.realtime and settings.pace_clock is not None
+    clock_start = (settings.pace_clock(), time.perf_counter()) if paced_on_clock else None
     policy.reset()
     if seed is not None:
         seed_policy(policy, seed)
@@ -256,9 +264,21 @@ def run_episode(
         raise
     finally:
         arm.idle()
+        if clock_start is not None and outcome.fault is None:
+            outcome.pace_clock_rate = _clock_rate(settings.pace_clock, *clock_start)
         outcome.timing = {name: timing_stats(values) for name, values in times.items()}
         outcome.clamped_targets = arm.clamped_targets
     return outcome
+
+
+def _clock_rate(clock: Callable[[], float], clock_start: float, wall_start: float) -> float | None:
+    """Seconds of ``clock`` per wall second since the starts (None: unreadable now, or no time passed)."""
+    try:
+        ticked = clock() - clock_start
+    except IgenError:  # the arm went away as the episode ended: its rate is not worth a second error
+        return None
+    wall = time.perf_counter() - wall_start
+    return ticked / wall if wall > 0 else None
 
 
 def _believed_poses(spec, T_world_others: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

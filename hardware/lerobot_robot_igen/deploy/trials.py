@@ -107,9 +107,14 @@ def _summary(name: str, outcomes: list[EpisodeOutcome]) -> dict:
     }
 
 
-def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray | None) -> LoopSettings:
-    """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame; None: 6-DOF)."""
+def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray | None, driver=None) -> LoopSettings:
+    """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame; None: 6-DOF).
+
+    ``driver``: the connected arm, whose own clock paces the loop with ``--pace_on=arm`` where it has one.
+    """
+    own_clock = driver is not None and cfg.pace_on == "arm" and driver.robot_time() is not None
     return LoopSettings(
+        pace_clock=driver.robot_time if own_clock else None,
         fps=cfg.fps,
         max_steps=cfg.max_steps,
         contact_force_threshold=cfg.contact_force_threshold,
@@ -154,7 +159,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         arm.close()
         driver.disconnect()
         raise
-    settings = loop_settings(cfg, goal_rotation)
+    settings = loop_settings(cfg, goal_rotation, driver)
     outcomes: list[EpisodeOutcome] = []
     step_times: list[float] = []
     period_times: list[float] = []
@@ -211,6 +216,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         "deployment": _summary("deployment", outcomes),
         "per_trial": [o.to_json() for o in outcomes],
         "loop": {"step": timing_stats(step_times), "period": timing_stats(period_times)},
+        "pace": _pace_summary(settings, outcomes),
         "seconds": time.perf_counter() - started,
     }
     if sim_result is not None:
@@ -223,6 +229,16 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         }
         report["per_trial_sim"] = same_trials
     return report
+
+
+def _pace_summary(settings: LoopSettings, outcomes: list[EpisodeOutcome]) -> dict:
+    """Which clock the periods were measured on, and how fast it ran against the wall clock (median over trials)."""
+    if not settings.realtime:
+        return {"clock": "none (as fast as the simulated arm steps)"}
+    if settings.pace_clock is None:
+        return {"clock": "wall"}
+    rates = [o.pace_clock_rate for o in outcomes if o.pace_clock_rate is not None]
+    return {"clock": "arm", "arm_seconds_per_wall_second": float(np.median(rates)) if rates else None}
 
 
 def _start_trial(cfg: DeployConfig, driver, poses, situations, world_from_base, i: int, seed: int):
