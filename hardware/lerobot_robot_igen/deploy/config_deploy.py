@@ -109,9 +109,7 @@ class DeployConfig:
     contact_force_threshold: float = 2.0  # [N]
     max_pose_age: float = 0.5  # [s]
     pose_gate: PoseGateSettings = field(default_factory=PoseGateSettings)  # confidence and jump checks
-    realtime: bool | None = (
-        None  # None: real arms pace to real time, rehearsals on the MuJoCo arm run as fast as they can
-    )
+    realtime: bool | None = None  # None: real arms in real time, the MuJoCo arm as fast as it steps
     # Which clock a real-time loop's 50 ms periods are measured on. "arm": the arm's own where it reports
     # one (franky: libfranka's robot time), else the wall clock; "wall": always the wall clock. On a real
     # Franka the two agree; franky-sim's Python 1 kHz loop runs at 0.5-0.9 of real time, so paced on
