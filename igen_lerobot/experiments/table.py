@@ -27,7 +27,7 @@ import shlex
 import subprocess
 import sys
 import time
-from dataclasses import MISSING, asdict, fields, replace
+from dataclasses import MISSING, asdict, fields, is_dataclass, replace
 from importlib.metadata import entry_points
 from pathlib import Path
 
@@ -184,7 +184,11 @@ def check_resumed_config(cfg: TableConfig) -> None:
         recorded_file.write_text(json.dumps(now, indent=2))
         return
     recorded = json.loads(recorded_file.read_text())
-    defaults = {f.name: f.default for f in fields(TableConfig) if f.default is not MISSING}  # keys added since
+    defaults = {  # keys added since the table was recorded: their defaults, factories included
+        f.name: f.default if f.default is not MISSING else _as_recorded(f.default_factory())
+        for f in fields(TableConfig)
+        if f.default is not MISSING or f.default_factory is not MISSING
+    }
     recorded = {**defaults, **recorded}
     changed = sorted(k for k in now if k not in RESUMABLE_CHANGES and recorded.get(k) != now[k])
     if recorded.get("train_seeds") and now["train_seeds"][0] != recorded["train_seeds"][0]:
@@ -195,6 +199,11 @@ def check_resumed_config(cfg: TableConfig) -> None:
             f"{cfg.output_dir} holds a table made with other settings ({detail}); give the same flags to "
             "resume it, or a new --output_dir for a new table"
         )
+
+
+def _as_recorded(value):
+    """A config value as ``table_config.json`` holds it (nested configs as dicts)."""
+    return json.loads(json.dumps(asdict(value) if is_dataclass(value) else value))
 
 
 def build_step(run: TableRun, step: DataStep, policy: str) -> None:
