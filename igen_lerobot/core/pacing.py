@@ -17,7 +17,8 @@ class RatePacer:
 
     ``clock``: the clock whose periods count (default: the wall clock). A robot's own clock
     (libfranka's robot time) makes a period the arm's 50 ms even where a simulator behind the
-    protocol runs slower than real time; it is polled, and a clock that stands still for
+    protocol runs slower than real time (it must not run faster: the wait sleeps what is left of
+    the period on it, then reads it again); a clock that stands still for
     ``stall_timeout`` seconds of wall time raises :class:`ClockStalledError` instead of hanging the loop.
     A late tick is not made up with a burst of short periods: the next period starts from it.
     """
@@ -49,5 +50,7 @@ class RatePacer:
                 raise ClockStalledError(
                     f"the loop's clock stood at {now:.3f} s for {self.stall_timeout} s of wall time"
                 )
-            time.sleep(min(self._next - now, 0.001))
+            # an arm's clock runs no faster than the wall clock: sleeping what is left of the period
+            # never overshoots, and a slower clock is polled a few times a period, not every millisecond
+            time.sleep(max(self._next - now, 0.0005))
             now = self.clock()
