@@ -6,9 +6,8 @@ from dataclasses import dataclass, field
 
 from lerobot.envs.configs import EnvConfig
 
-from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import ErrorModel
-from igen_lerobot.core.paper import VARIANTS, PaperTable
+from igen_lerobot.core.paper import main_table
 from igen_lerobot.core.task import TaskEnv
 from lerobot_env_igen.coffee.spec import GEOMETRY, SPEC, paper_corruption
 from lerobot_env_igen.config_in_hand_insertion import InHandInsertionEnvConfig
@@ -27,20 +26,7 @@ class CoffeeEnvConfig(InHandInsertionEnvConfig):
     base_spec = SPEC
     geometry = GEOMETRY
     paper_tables = (
-        PaperTable(
-            reveal=Reveal.FULL,
-            rows=VARIANTS,
-            success={
-                "base": 2,
-                "source_int": 10,
-                "weighted_src_int": 6,
-                "source_demo": 12,
-                "mg_demo": 18,
-                "igen_no_policy": 42,
-                "igen": 80,
-            },
-            caption="main table: noisy pose estimation, full observability upon contact",
-        ),
+        main_table(base=2, source_int=10, weighted_src_int=6, source_demo=12, mg_demo=18, igen_no_policy=42, igen=80),
     )
 
     task: str | None = "Coffee-v0"

@@ -8,7 +8,7 @@ from lerobot.envs.configs import EnvConfig
 
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import ErrorModel
-from igen_lerobot.core.paper import VARIANTS, PaperTable
+from igen_lerobot.core.paper import PaperTable, main_table
 from igen_lerobot.core.task import TaskEnv
 from lerobot_env_igen.config_in_hand_insertion import InHandInsertionEnvConfig
 from lerobot_env_igen.nut_insertion.spec import GEOMETRY, SPEC, paper_corruption
@@ -27,20 +27,7 @@ class NutInsertionEnvConfig(InHandInsertionEnvConfig):
     base_spec = SPEC
     geometry = GEOMETRY
     paper_tables = (
-        PaperTable(
-            reveal=Reveal.FULL,
-            rows=VARIANTS,
-            success={
-                "base": 22,
-                "source_int": 40,
-                "weighted_src_int": 50,
-                "source_demo": 42,
-                "mg_demo": 64,
-                "igen_no_policy": 86,
-                "igen": 98,
-            },
-            caption="main table: noisy pose estimation, full observability upon contact",
-        ),
+        main_table(base=22, source_int=40, weighted_src_int=50, source_demo=42, mg_demo=64, igen_no_policy=86, igen=98),
         PaperTable(
             reveal=Reveal.CONTACT_POSITION,
             rows=("base", "source_int", "mg_demo", "igen_no_policy", "igen"),

@@ -8,7 +8,7 @@ from lerobot.envs.configs import EnvConfig
 
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import ErrorModel
-from igen_lerobot.core.paper import VARIANTS, PaperTable
+from igen_lerobot.core.paper import PaperTable, main_table
 from igen_lerobot.core.task import TaskEnv
 from lerobot_env_igen.config_in_hand_insertion import InHandInsertionEnvConfig
 from lerobot_env_igen.placement import UniformRegion
@@ -28,20 +28,7 @@ class TwoPieceAssemblyEnvConfig(InHandInsertionEnvConfig):
     base_spec = SPEC
     geometry = GEOMETRY
     paper_tables = (
-        PaperTable(
-            reveal=Reveal.FULL,
-            rows=VARIANTS,
-            success={
-                "base": 6,
-                "source_int": 6,
-                "weighted_src_int": 16,
-                "source_demo": 12,
-                "mg_demo": 16,
-                "igen_no_policy": 52,
-                "igen": 70,
-            },
-            caption="main table: noisy pose estimation, full observability upon contact",
-        ),
+        main_table(base=6, source_int=6, weighted_src_int=16, source_demo=12, mg_demo=16, igen_no_policy=52, igen=70),
         PaperTable(
             reveal=Reveal.DIRECTION,
             rows=("base", "source_int", "mg_demo", "igen_no_policy", "igen"),
