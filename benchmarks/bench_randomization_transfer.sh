@@ -12,13 +12,19 @@
 #   MUJOCO_GL=egl bash benchmarks/bench_randomization_transfer.sh outputs/bg_igen1 outputs/bg_igen_rand [TRIALS] [SETTING]
 # The table's own I-Gen checkpoint is rehearsed once per pace clock, into TABLE_DIR/rehearsal_igen_<pace>, and
 # reused by every setting. PACE_ON=arm|wall (default arm): the clock franky's 20 Hz periods are measured on
-# (igen-deploy --pace_on); franky-sim's own runs slower than the wall clock.
+# (igen-deploy --pace_on); franky-sim's own runs slower than the wall clock. TRAIN_SEED (default 1000): the
+# randomised row's training seed; another seed trains on the same data into train/igen_seed<N> and
+# validates, tests and rehearses into files with the same suffix (the plain checkpoint stays seed 1000's).
+# REHEARSE=0 stops after the test trials: train beside other jobs, rehearse later on an idle machine.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
 out=${2:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
 trials=${3:-20}
 setting=${4:-all}
+train_seed=${TRAIN_SEED:-1000}
+suffix=""
+[ "$train_seed" = 1000 ] || suffix=_seed$train_seed
 bin=.venv/bin
 source benchmarks/randomization_settings.sh
 [ -n "${RANDOMIZE_SETTINGS[$setting]+set}" ] && [ "$setting" != none ] \
@@ -43,29 +49,33 @@ step igen "$out/data/igen/meta/igen.json" "$bin/igen-generate" --mode=igen --env
   --dataset.root="$out/data/igen"
 step merge "$out/data/train_igen/meta/igen.json" "$bin/igen-merge" --task=block_grasp \
   "--inputs=[$out/data/base,$out/data/igen]" --dataset.root="$out/data/train_igen"
-step train "$out/train/igen/checkpoints/002000/pretrained_model/config.json" "$bin/lerobot-train" --policy.type=bc_rnn \
+run=$out/train/igen$suffix
+step "train$suffix" "$run/checkpoints/002000/pretrained_model/config.json" "$bin/lerobot-train" --policy.type=bc_rnn \
   --policy.device=cpu --policy.push_to_hub=false --dataset.repo_id=local/train_igen \
-  --dataset.root="$out/data/train_igen" --output_dir="$out/train/igen" --steps=2000 --batch_size=100 --num_workers=2 \
-  --save_freq=500 --seed=1000 --wandb.enable=false
-step validate "$out/eval/validation.json" "$bin/igen-eval" --env.type=block_grasp --train_dir="$out/train/igen" \
-  --n_trials=20 --seed=1000003 --output="$out/eval/validation.json"
-chosen=$("$bin/python" -c "import json,sys; print(json.load(open(sys.argv[1]))['best']['step'])" "$out/eval/validation.json")
-checkpoint=$(printf '%s/train/igen/checkpoints/%06d/pretrained_model' "$out" "$chosen")
-step test "$out/eval/test.json" "$bin/igen-eval" --env.type=block_grasp --policy.path="$checkpoint" --n_trials=50 \
-  --seed=2000003 --output="$out/eval/test.json"
+  --dataset.root="$out/data/train_igen" --output_dir="$run" --steps=2000 --batch_size=100 --num_workers=2 \
+  --save_freq=500 --seed="$train_seed" --wandb.enable=false
+validation=$out/eval/validation$suffix.json
+test=$out/eval/test$suffix.json
+step "validate$suffix" "$validation" "$bin/igen-eval" --env.type=block_grasp --train_dir="$run" \
+  --n_trials=20 --seed=1000003 --output="$validation"
+chosen=$("$bin/python" -c "import json,sys; print(json.load(open(sys.argv[1]))['best']['step'])" "$validation")
+checkpoint=$(printf '%s/checkpoints/%06d/pretrained_model' "$run" "$chosen")
+step "test$suffix" "$test" "$bin/igen-eval" --env.type=block_grasp --policy.path="$checkpoint" --n_trials=50 \
+  --seed=2000003 --output="$test"
 plain=$("$bin/python" - "$table" <<'PY'
 import sys
 from igen_lerobot.experiments.table import chosen_checkpoint
 print(chosen_checkpoint(sys.argv[1], "igen", 1000)[1])
 PY
 )
+[ "${REHEARSE:-1}" = 1 ] || exit 0
 pace=${PACE_ON:-arm}
 plain_rehearsal=$table/rehearsal_igen_$pace  # the table's own checkpoint: rehearsed once, whatever the setting
-randomised_rehearsal=$out/rehearsal_randomised_$pace
+randomised_rehearsal=$out/rehearsal_randomised_$pace$suffix
 [ -e "$plain_rehearsal/franky.json" ] || bash benchmarks/bench_rehearsal.sh "$plain" "$trials" "$plain_rehearsal" --pace_on="$pace"
 [ -e "$randomised_rehearsal/franky.json" ] \
   || bash benchmarks/bench_rehearsal.sh "$checkpoint" "$trials" "$randomised_rehearsal" --pace_on="$pace"
 echo "plain I-Gen ($plain):"
 "$bin/python" benchmarks/rehearsal_summary.py "$plain_rehearsal/mujoco.json" "$plain_rehearsal/franky.json"
-echo "randomised I-Gen ($checkpoint), test trials: $("$bin/python" -c "import json,sys; b=json.load(open(sys.argv[1]))['best']; print(b['successes'], '/', b['trials'])" "$out/eval/test.json")"
+echo "randomised I-Gen ($checkpoint), test trials: $("$bin/python" -c "import json,sys; b=json.load(open(sys.argv[1]))['best']; print(b['successes'], '/', b['trials'])" "$test")"
 "$bin/python" benchmarks/rehearsal_summary.py "$randomised_rehearsal/mujoco.json" "$randomised_rehearsal/franky.json"
