@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Every paper table of docs/results.md, made from scratch in the published protocol, one after the
+# other, each a single igen-table command (3 training seeds, checkpoint chosen on validation
+# trials, reported on test trials). Hours of CPU per table: run it at low priority and rerun it to
+# resume; a finished table is written to docs/results/<name>.json and docs/results.md re-rendered.
+#
+#   nice -n 10 bash benchmarks/paper_tables.sh                 # every table, in the order below
+#   nice -n 10 bash benchmarks/paper_tables.sh nut_insertion   # the tables named
+#   DRY_RUN=true bash benchmarks/paper_tables.sh coffee        # the commands each would run
+#
+# Every row of every table trains the same way: TRAIN (the in-hand tasks and Nut-and-Peg train 5000
+# steps, Block Grasp the paper's 2000) plus PROTOCOL, the settings every table shares.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+root=${OUT_ROOT:-outputs/tables}
+bin=.venv/bin
+PROTOCOL=(${PROTOCOL:-})
+long=(--train.steps=5000 --train.save_freq=1000)
+declare -A TABLES=(
+  [block_grasp]="--task=block_grasp"
+  [nut_insertion]="--task=nut_insertion ${long[*]}"
+  [nut_insertion_contact_position]="--task=nut_insertion --reveal=contact_position ${long[*]}"
+  [two_piece_assembly]="--task=two_piece_assembly ${long[*]}"
+  [two_piece_assembly_direction]="--task=two_piece_assembly --reveal=direction ${long[*]}"
+  [coffee]="--task=coffee ${long[*]}"
+  [two_piece_assembly_scaling]="--task=two_piece_assembly --table=scaling ${long[*]}"
+  [nut_and_peg]="--task=nut_and_peg ${long[*]}"
+)
+ORDER=(block_grasp nut_insertion nut_insertion_contact_position two_piece_assembly coffee
+  two_piece_assembly_direction two_piece_assembly_scaling nut_and_peg)
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=("${ORDER[@]}")
+for name in "${names[@]}"; do
+  [ -n "${TABLES[$name]+set}" ] || { echo "unknown table '$name'; one of: ${ORDER[*]}"; exit 2; }
+done
+mkdir -p "$root"
+for name in "${names[@]}"; do
+  read -r -a flags <<< "${TABLES[$name]}"
+  command=("$bin/igen-table" "${flags[@]}" "${PROTOCOL[@]}" --output_dir="$root/$name" --dry_run="${DRY_RUN:-false}")
+  echo "$(date +%T) $name: ${command[*]}"
+  if [ "${DRY_RUN:-false}" = true ]; then "${command[@]}"; else "${command[@]}" >> "$root/$name.log" 2>&1; fi
+done
