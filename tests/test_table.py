@@ -154,6 +154,21 @@ def test_provenance_check_names_what_is_missing():
     assert problems[0].startswith("no commit") and "train_seeds" in problems[1]
 
 
+def test_every_step_records_the_machine_it_ran_on_and_the_page_says_when_they_differ():
+    from igen_lerobot.experiments.provenance import machine_line
+
+    here = code_version()["machine"]
+    assert "cores" in here and "torch" in here, here
+    one = {"step_code": {"base": code_version(), "train_base_seed0": code_version()}}
+    assert machine_line(one) == f"- Machine: every step ran on {here}."
+    mixed = {"step_code": {**one["step_code"], "eval_base": {"commit": "a" * 40, "machine": "other CPU"}}}
+    line = machine_line(mixed)
+    assert line.startswith("- Machine: steps ran on 2 machines") and f"{here}: 2 steps" in line
+    assert "other CPU: 1 step;" in line
+    older = {"step_code": {"base": {"commit": "a" * 40}}}  # recorded before machines were
+    assert machine_line(older) == "- Machine: not recorded (the steps ran before machines were)."
+
+
 def test_superseded_tables_render_with_their_curves():
     from igen_lerobot.experiments.table_report import load_superseded, render_page
 

@@ -1,11 +1,16 @@
-"""Which code made a result: the git commit of the checkout igen-lerobot runs from.
+"""Which code, on which machine, made a result: the git commit of the checkout and the CPU it ran on.
 
 A table runs for hours and resumes across sessions; its JSON names the commit of every step so
 a reader can tell a table made by one code version from one assembled while the code changed.
+It names the machine too: a training run is bit-identical for a seed on one machine, but the same
+command and data gave a different Nut Insertion base policy on another day's host
+(docs/results/reproducibility.md), so a step's machine is part of what made it.
 """
 
 from __future__ import annotations
 
+import os
+import platform
 import subprocess
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -23,10 +28,46 @@ def _git(*args: str) -> str | None:
     return done.stdout.strip() if done.returncode == 0 else None
 
 
-def code_version() -> dict:
-    """``{"commit", "dirty", "version"}``: commit None when not run from a git checkout (an installed wheel).
+def _cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
 
-    ``dirty`` says tracked files differ from the commit, so the commit alone does not name the code.
+
+def _vector_units() -> str:
+    """The widest x86 vector extension the CPU has: PyTorch's CPU kernels (and their rounding) follow it."""
+    try:
+        flags = next(
+            (
+                line.split(":", 1)[1].split()
+                for line in Path("/proc/cpuinfo").read_text().splitlines()
+                if line.startswith("flags")
+            ),
+            [],
+        )
+    except OSError:
+        flags = []
+    return next((unit for unit in ("avx512f", "avx2", "sse4_2") if unit in flags), platform.machine())
+
+
+def machine_identity() -> str:
+    """``"AMD EPYC, 2 cores, avx512f, torch 2.7.1"``: what a bit-identical rerun of a training step needs to match."""
+    try:
+        torch = version("torch")
+    except PackageNotFoundError:
+        torch = "not installed"
+    return f"{_cpu_model()}, {os.cpu_count()} cores, {_vector_units()}, torch {torch}"
+
+
+def code_version() -> dict:
+    """``{"commit", "dirty", "version", "machine"}``: commit None when not run from a git checkout (a wheel).
+
+    ``dirty`` says tracked files differ from the commit, so the commit alone does not name the code;
+    ``machine`` is :func:`machine_identity`.
     """
     try:
         package = version("igen-lerobot")
@@ -37,7 +78,7 @@ def code_version() -> dict:
     if commit is not None:
         status = _git("status", "--porcelain", "--untracked-files=no")
         dirty = None if status is None else bool(status)
-    return {"commit": commit, "dirty": dirty, "version": package}
+    return {"commit": commit, "dirty": dirty, "version": package, "machine": machine_identity()}
 
 
 def provenance_problems(result: dict) -> list[str]:
@@ -88,10 +129,25 @@ def code_line(result: dict) -> str:
     return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
 
 
+def machine_line(result: dict) -> str:
+    """Which machines ran the table's steps (steps recorded before machines were: "unrecorded")."""
+    by_machine: dict[str, int] = {}
+    for code in result.get("step_code", {}).values():
+        key = (code or {}).get("machine") or "unrecorded"
+        by_machine[key] = by_machine.get(key, 0) + 1
+    if set(by_machine) == {"unrecorded"}:
+        return "- Machine: not recorded (the steps ran before machines were)."
+    if len(by_machine) == 1:
+        return f"- Machine: every step ran on {next(iter(by_machine))}."
+    parts = "; ".join(f"{machine}: {n} step{'' if n == 1 else 's'}" for machine, n in sorted(by_machine.items()))
+    return f"- Machine: steps ran on {len(by_machine)} machines ({parts}; per step in the JSON)."
+
+
 def provenance_lines(result: dict) -> list[str]:
-    """How a recorded run was made: its code versions, its wall time and every command, as the page shows them."""
+    """How a recorded run was made: its code versions and machines, its wall time and every command."""
     return [
         code_line(result),
+        machine_line(result),
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
         "",
