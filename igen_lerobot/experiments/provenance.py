@@ -2,9 +2,10 @@
 
 A table runs for hours and resumes across sessions; its JSON names the commit of every step so
 a reader can tell a table made by one code version from one assembled while the code changed.
-It names the machine too: a training run is bit-identical for a seed on one machine, but the same
-command and data gave a different Nut Insertion base policy on another day's host
-(docs/results/reproducibility.md), so a step's machine is part of what made it.
+It names the machine too: a training run is bit-identical for a seed on one machine, but the Nut
+Insertion base policy trained from the same data and seed on another day's host was, as far as we
+could measure, a different one (docs/results/reproducibility.md), so a step's machine is part of
+what made it.
 """
 
 from __future__ import annotations
