@@ -9,6 +9,7 @@
 #   bash benchmarks/bench_rehearsal.sh outputs/bg_igen/train/igen/checkpoints/last/pretrained_model 20 outputs/rehearsal
 # FRANKY_CONTROLLER=trajectory|impedance picks the franky backend's controller (default: the backend's own).
 # Further arguments go to the franky igen-deploy run, e.g. --robot.tracker_stiffness=3000.
+# HAND_ORIENTATION=goal|measured sets igen-deploy --hand_orientation on both paths (default: igen-deploy's).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 CHECKPOINT=${1:?usage: bench_rehearsal.sh CHECKPOINT/pretrained_model|scripted [TRIALS] [OUT_DIR] [igen-deploy args]}
@@ -20,7 +21,8 @@ PORT=${FRANKY_SIM_SCENE_PORT:-7711}
 CONTROLLER=()
 [ -n "${FRANKY_CONTROLLER:-}" ] && CONTROLLER=(--robot.controller="$FRANKY_CONTROLLER")
 POLICY=(--policy.path="$CHECKPOINT")
-[ "$CHECKPOINT" = scripted ] && POLICY=()  # the task's scripted policy (acts on what it believes)
+[ -n "${HAND_ORIENTATION:-}" ] && POLICY+=(--hand_orientation="$HAND_ORIENTATION")
+[ "$CHECKPOINT" = scripted ] && POLICY=("${POLICY[@]:1}")  # the task's scripted policy (acts on what it believes)
 mkdir -p "$OUT"
 export MUJOCO_GL=${MUJOCO_GL:-egl}
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -163,6 +164,40 @@ def test_the_policy_observes_the_goal_orientation_unless_told_to_observe_the_mea
         )
     with pytest.raises(ConfigError, match="--hand_orientation='tilted'"):
         DeployConfig(hand_orientation="tilted")
+
+
+def _checkpoint_trained_on(tmp_path: Path, name: str, meta: dict | None) -> Path:
+    """A pretrained_model/ folder whose train_config.json names a dataset with ``meta`` as its igen.json."""
+    root = tmp_path / f"{name}_data"
+    if meta is not None:
+        (root / "meta").mkdir(parents=True)
+        (root / "meta" / "igen.json").write_text(json.dumps(meta))
+    checkpoint = tmp_path / name / "pretrained_model"
+    checkpoint.mkdir(parents=True)
+    (checkpoint / "train_config.json").write_text(json.dumps({"dataset": {"repo_id": "local/x", "root": str(root)}}))
+    return checkpoint
+
+
+def test_auto_hand_orientation_follows_the_training_data(tmp_path):
+    """A policy trained on tilt-randomised data (here a merged dataset with one such part) is told the
+    measured orientation; one trained without, the goal; one whose data cannot be found, the goal,
+    with a reason that names the flag to pass."""
+    from lerobot_robot_igen.deploy.hand_orientation import resolve_hand_orientation
+
+    plain = {"kind": "simulation", "robot": "panda"}
+    tilted = {**plain, "randomization": {"kp_scale": [0.5, 1.5], "hand_tilt_deg": 3.0}}
+    merged = {"origin": {"kind": "merge"}, "parts": [{"origin": plain}, {"origin": tilted}]}
+    mode, why = resolve_hand_orientation("auto", str(_checkpoint_trained_on(tmp_path, "rand", merged)))
+    assert mode == "measured" and "3 deg" in why
+    mode, why = resolve_hand_orientation("auto", str(_checkpoint_trained_on(tmp_path, "plain", {"origin": plain})))
+    assert mode == "goal" and "without hand tilt" in why
+    mode, why = resolve_hand_orientation("auto", str(_checkpoint_trained_on(tmp_path, "gone", None)))
+    assert mode == "goal" and "--hand_orientation=measured" in why
+    assert resolve_hand_orientation("auto", str(tmp_path / "hub_only"))[0] == "goal"  # no train_config.json
+    assert resolve_hand_orientation("auto", None)[0] == "goal"  # the scripted policy
+    assert resolve_hand_orientation("measured", str(_checkpoint_trained_on(tmp_path, "p2", {"origin": plain})))[0] == (
+        "measured"
+    )
 
 
 def test_rendered_camera_and_icp_in_the_loop():

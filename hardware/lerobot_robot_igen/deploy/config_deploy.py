@@ -76,7 +76,7 @@ class RealSensePerceptionConfig(PerceptionConfig):
             )
 
 
-HAND_ORIENTATIONS = ("goal", "measured")  # --hand_orientation
+HAND_ORIENTATIONS = ("auto", "goal", "measured")  # --hand_orientation
 PACE_CLOCKS = ("arm", "wall")  # --pace_on
 
 
@@ -123,11 +123,13 @@ class DeployConfig:
     rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log every step
     # What the policy is told the hand's orientation is. "goal": the task's fixed goal orientation,
     # which its controller holds (position-only actions cannot change it; 6-DOF tasks have none and
-    # observe the measured one); "measured": the arm's
-    # reading. The training arm's reading carries its own dynamic tilt (a few tenths of a degree
-    # while it moves), which a policy can learn to read and no other arm reproduces
-    # (docs/benchmarks.md: a constant 0.2 degree tilt took the Block Grasp checkpoint from 19/20 to 4/20).
-    hand_orientation: str = "goal"
+    # observe the measured one); "measured": the arm's reading. The training arm's reading carries its
+    # own dynamic tilt (a few tenths of a degree while it moves), which a policy can learn to read and
+    # no other arm reproduces (docs/benchmarks.md: a constant 0.2 degree tilt took the Block Grasp
+    # checkpoint from 19/20 to 4/20); a policy trained with --env.randomize.hand_tilt_deg saw tilted
+    # readings and wants the measured one. "auto": measured for such a policy, else goal, read from the
+    # training data its train_config.json names (deploy/hand_orientation.py).
+    hand_orientation: str = "auto"
 
     def __post_init__(self) -> None:
         if self.hand_orientation not in HAND_ORIENTATIONS:

@@ -33,6 +33,7 @@ from lerobot_robot_igen.deploy.config_deploy import (
     RenderedPerceptionConfig,
     TruthPerceptionConfig,
 )
+from lerobot_robot_igen.deploy.hand_orientation import resolve_hand_orientation
 from lerobot_robot_igen.deploy.loop import EpisodeOutcome, LoopSettings, StepRecord, run_episode, timing_stats
 from lerobot_robot_igen.perception.pose_source import PoseSource
 
@@ -107,11 +108,15 @@ def _summary(name: str, outcomes: list[EpisodeOutcome]) -> dict:
     }
 
 
-def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray | None, driver=None) -> LoopSettings:
+def loop_settings(
+    cfg: DeployConfig, goal_rotation: np.ndarray | None, driver=None, hand_orientation: str | None = None
+) -> LoopSettings:
     """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame; None: 6-DOF).
 
     ``driver``: the connected arm, whose own clock paces the loop with ``--pace_on=arm`` where it has one.
+    ``hand_orientation``: ``goal`` or ``measured``, as ``--hand_orientation`` resolved (default: as given).
     """
+    hand_orientation = hand_orientation or cfg.hand_orientation
     own_clock = driver is not None and cfg.pace_on == "arm" and driver.robot_time() is not None
     return LoopSettings(
         pace_clock=driver.robot_time if own_clock else None,
@@ -121,7 +126,7 @@ def loop_settings(cfg: DeployConfig, goal_rotation: np.ndarray | None, driver=No
         max_pose_age=cfg.max_pose_age,
         realtime=bool(cfg.realtime),
         pose_gate=cfg.pose_gate,
-        observed_hand_rotation=goal_rotation if cfg.hand_orientation == "goal" else None,  # None: measured
+        observed_hand_rotation=goal_rotation if hand_orientation == "goal" else None,  # None: measured
     )
 
 
@@ -133,6 +138,8 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
 
     torch.set_num_threads(cfg.inference_threads)
     policy = make_base_policy(cfg.policy, env_cfg)
+    hand_orientation, hand_orientation_reason = resolve_hand_orientation(cfg.hand_orientation, cfg.policy.path)
+    logger.info("the policy is told the %s hand orientation (%s)", hand_orientation, hand_orientation_reason)
     # the task's MuJoCo scene is needed before the arm: igen-eval's rollouts for --compare_sim, and the
     # situations a franky-sim rehearsal recreates (done first, so no arm idles connected meanwhile)
     sim_result = None
@@ -159,7 +166,7 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         arm.close()
         driver.disconnect()
         raise
-    settings = loop_settings(cfg, goal_rotation, driver)
+    settings = loop_settings(cfg, goal_rotation, driver, hand_orientation)
     outcomes: list[EpisodeOutcome] = []
     step_times: list[float] = []
     period_times: list[float] = []
@@ -210,7 +217,8 @@ def deploy(cfg: DeployConfig, on_step=None) -> dict:
         "policy": cfg.policy.describe(),
         "robot": cfg.robot.get_choice_name(type(cfg.robot)),
         "perception": cfg.perception.get_choice_name(type(cfg.perception)),
-        "hand_orientation": cfg.hand_orientation,
+        "hand_orientation": hand_orientation,
+        "hand_orientation_reason": hand_orientation_reason,
         "seed": cfg.seed,
         "trial_seeds": [episode_seed(cfg.seed, i) for i in range(len(outcomes))],  # igen-eval's, in a rehearsal
         "deployment": _summary("deployment", outcomes),
