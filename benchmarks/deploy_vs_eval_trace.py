@@ -56,10 +56,9 @@ def deploy_trace(cfg, trial: int):
     records = []
     cfg.trials = trial + 1
     report = deploy(cfg, on_step=records.append)
-    last = [r for r in records if r.step <= cfg.max_steps]
-    # records of the last trial: its steps count up from 0 again
-    start = max(i for i, r in enumerate(last) if r.step == min(r.step for r in last))
-    ours = last[start:]
+    # the last trial's records: each trial's steps count up from the same first step again
+    first_step = min(r.step for r in records)
+    ours = records[max(i for i, r in enumerate(records) if r.step == first_step) :]
     outcome = report["per_trial"][-1]
     return outcome["success"], outcome["steps"], [r.observation for r in ours], [r.action for r in ours], ours
 
