@@ -195,6 +195,16 @@ def test_auto_hand_orientation_follows_the_training_data(tmp_path):
     assert mode == "goal" and "--hand_orientation=measured" in why
     assert resolve_hand_orientation("auto", str(tmp_path / "hub_only"))[0] == "goal"  # no train_config.json
     assert resolve_hand_orientation("auto", None)[0] == "goal"  # the scripted policy
+    broken = _checkpoint_trained_on(tmp_path, "broken", {"origin": plain})
+    (broken / "train_config.json").write_text("{not json")
+    mode, why = resolve_hand_orientation("auto", str(broken))
+    assert mode == "goal" and "not a lerobot-train config" in why
+    # the loop's settings never take "auto" for "measured": unresolved, they resolve it themselves
+    from lerobot_robot_igen.deploy.trials import loop_settings
+
+    goal = np.eye(3)
+    assert loop_settings(DeployConfig(hand_orientation="auto"), goal).observed_hand_rotation is goal
+    assert loop_settings(DeployConfig(hand_orientation="measured"), goal).observed_hand_rotation is None
     assert resolve_hand_orientation("measured", str(_checkpoint_trained_on(tmp_path, "p2", {"origin": plain})))[0] == (
         "measured"
     )

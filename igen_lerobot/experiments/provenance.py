@@ -29,29 +29,18 @@ def _git(*args: str) -> str | None:
     return done.stdout.strip() if done.returncode == 0 else None
 
 
-def _cpu_model() -> str:
+def _cpuinfo(field: str) -> str | None:
+    """The first ``field`` line of /proc/cpuinfo (Linux), None elsewhere."""
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
+        lines = Path("/proc/cpuinfo").read_text().splitlines()
     except OSError:
-        pass
-    return platform.processor() or platform.machine()
+        return None
+    return next((line.split(":", 1)[1].strip() for line in lines if line.startswith(field)), None)
 
 
 def _vector_units() -> str:
     """The widest x86 vector extension the CPU has: PyTorch's CPU kernels (and their rounding) follow it."""
-    try:
-        flags = next(
-            (
-                line.split(":", 1)[1].split()
-                for line in Path("/proc/cpuinfo").read_text().splitlines()
-                if line.startswith("flags")
-            ),
-            [],
-        )
-    except OSError:
-        flags = []
+    flags = (_cpuinfo("flags") or "").split()
     return next((unit for unit in ("avx512f", "avx2", "sse4_2") if unit in flags), platform.machine())
 
 
@@ -61,7 +50,8 @@ def machine_identity() -> str:
         torch = version("torch")
     except PackageNotFoundError:
         torch = "not installed"
-    return f"{_cpu_model()}, {os.cpu_count()} cores, {_vector_units()}, torch {torch}"
+    cpu = _cpuinfo("model name") or platform.processor() or platform.machine()
+    return f"{cpu}, {os.cpu_count()} cores, {_vector_units()}, torch {torch}"
 
 
 def code_version() -> dict:

@@ -32,12 +32,18 @@ def training_hand_tilt(policy_path: str | Path) -> tuple[float | None, str]:
     config = Path(policy_path) / "train_config.json"
     if not config.exists():
         return None, f"{config} is missing"
-    dataset = json.loads(config.read_text()).get("dataset") or {}
+    try:
+        dataset = json.loads(config.read_text()).get("dataset") or {}
+    except (json.JSONDecodeError, AttributeError):
+        return None, f"{config} is not a lerobot-train config (no JSON object)"
     root = dataset.get("root")
     meta_path = Path(root) / "meta" / "igen.json" if root else None
     if meta_path is None or not meta_path.exists():
         return None, f"the training dataset {root or dataset.get('repo_id')!r} has no meta/igen.json on this machine"
-    meta = json.loads(meta_path.read_text())
+    try:
+        meta = json.loads(meta_path.read_text())
+    except json.JSONDecodeError:
+        return None, f"{meta_path} is not valid JSON"
     tilts = [float((origin.get("randomization") or {}).get("hand_tilt_deg") or 0.0) for origin in _origins(meta)]
     return max(tilts), str(meta_path)
 

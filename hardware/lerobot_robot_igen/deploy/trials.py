@@ -114,9 +114,11 @@ def loop_settings(
     """The loop's settings from the command line; ``goal_rotation`` is the task's (task frame; None: 6-DOF).
 
     ``driver``: the connected arm, whose own clock paces the loop with ``--pace_on=arm`` where it has one.
-    ``hand_orientation``: ``goal`` or ``measured``, as ``--hand_orientation`` resolved (default: as given).
+    ``hand_orientation``: ``goal`` or ``measured``, as ``--hand_orientation`` resolved (None: resolved here,
+    so that ``auto`` never reaches the loop unresolved).
     """
-    hand_orientation = hand_orientation or cfg.hand_orientation
+    if hand_orientation is None:
+        hand_orientation, _ = resolve_hand_orientation(cfg.hand_orientation, cfg.policy.path)
     own_clock = driver is not None and cfg.pace_on == "arm" and driver.robot_time() is not None
     return LoopSettings(
         pace_clock=driver.robot_time if own_clock else None,
