@@ -22,25 +22,26 @@ from igen_lerobot.experiments.table_report import render_page
 from igen_lerobot.training.config_train import TrainConfig
 
 ROWS = ["base", "igen"]
-SEED = 7
+SEEDS = [7, 8]
 
 
 def fake_table(tmp_path: Path, checkpoint: Path) -> Path:
-    """A table dir laid out as igen-table leaves it, whose runs of ROWS (seed 7) all chose ``checkpoint``."""
+    """A table dir laid out as igen-table leaves it, whose runs of ROWS (seeds 7, 8) all chose ``checkpoint``."""
     train_out = checkpoint.parents[2]  # <output_dir>/checkpoints/<step>/pretrained_model (not last/)
     step = int(checkpoint.parent.name)
     table = tmp_path / "table"
-    cfg = TableConfig(train=TrainConfig(steps=step), train_seeds=[SEED], n_val_trials=1)
+    cfg = TableConfig(train=TrainConfig(steps=step), train_seeds=SEEDS, n_val_trials=1)
     table.mkdir()
     (table / "table_config.json").write_text(json.dumps(asdict(cfg)))
     for row in ROWS:
         (table / "train" / row).mkdir(parents=True)
-        (table / "train" / row / f"seed{SEED}").symlink_to(train_out)
-        result = {"policy": str(checkpoint), "trials": 1, "successes": 0, "success_rate": 0.0, "ci95": [0, 0.79]}
-        result |= {"mean_steps": 10.0, "seconds": 1.0, "per_trial": [False], "step": step}
-        validation = table / "eval" / row / f"seed{SEED}" / "validation.json"
-        validation.parent.mkdir(parents=True)
-        validation.write_text(json.dumps({"results": [result]}))
+        for seed in SEEDS:
+            (table / "train" / row / f"seed{seed}").symlink_to(train_out)
+            result = {"policy": str(checkpoint), "trials": 1, "successes": 0, "success_rate": 0.0, "ci95": [0, 0.79]}
+            result |= {"mean_steps": 10.0, "seconds": 1.0, "per_trial": [False], "step": step}
+            validation = table / "eval" / row / f"seed{seed}" / "validation.json"
+            validation.parent.mkdir(parents=True)
+            validation.write_text(json.dumps({"results": [result]}))
     return table
 
 
@@ -60,20 +61,24 @@ def rehearse(table: Path, tmp_path: Path, paths: list[str], **kwargs) -> dict:
     return run_rehearsal(cfg)
 
 
-def check_report(result: dict, table: Path, tmp_path: Path, paths: list[str]) -> None:
-    """A row per (row, path), the same trials on every path, intervals, the page rendered from the JSON."""
+def check_report(result: dict, table: Path, tmp_path: Path, paths: list[str], seeds: list[int] = SEEDS) -> None:
+    """A row per (row, path) pooling every training seed, the same trials everywhere, the page from the JSON."""
     assert [(r["variant"], r["path"]) for r in result["results"]] == [(row, p) for row in ROWS for p in paths]
-    seeds = {json.dumps(r["trial_seeds"]) for r in result["results"]}
-    assert len(seeds) == 1 and len(json.loads(seeds.pop())) == 1
+    trial_seeds = {json.dumps(r["trial_seeds"]) for r in result["results"]}
+    assert len(trial_seeds) == 1 and len(json.loads(trial_seeds.pop())) == 1
     for entry in result["results"]:
         low, high = entry["ci95"]
-        assert entry["trials"] == 1 and 0 <= low <= entry["success_rate"] <= high <= 1
-    assert result["trial_seed"] == TableConfig().test_seed and result["seed"] == SEED
-    assert "training seed 7 (the table's first)" in result["checkpoint_choice"]
+        assert entry["trials"] == len(seeds) and 0 <= low <= entry["success_rate"] <= high <= 1
+        assert [s["seed"] for s in entry["per_seed"]] == seeds
+        assert entry["successes"] == sum(s["successes"] for s in entry["per_seed"])
+        assert all(s["trials"] == 1 and len(s["per_trial"]) == 1 for s in entry["per_seed"])
+    assert result["trial_seed"] == TableConfig().test_seed and result["seeds"] == seeds
+    assert f"({', '.join(map(str, seeds))}); a cell pools their trials" in result["checkpoint_choice"]
     assert result["trial_choice"].startswith("the table's test trials (seed 2000003)")
-    assert set(result["step_times_s"]) == {f"{p}_{row}" for row in ROWS for p in paths}
+    assert set(result["step_times_s"]) == {f"{p}_{row}_seed{s}" for row in ROWS for p in paths for s in seeds}
     page = (tmp_path / "results.md").read_text()
-    assert "rehearsal: the sim-to-real rows" in page and "| I-Gen | 3 |" in page
+    steps = ", ".join(["3"] * len(seeds))
+    assert "rehearsal: the sim-to-real rows" in page and f"| I-Gen | {steps} |" in page
     saved = json.loads((tmp_path / "results" / "block_grasp_rehearsal.json").read_text())
     assert saved["results"] == result["results"]
     problems = provenance_problems(saved)
@@ -88,7 +93,10 @@ def test_rehearsal_runs_igen_eval_and_the_mujoco_arm_on_the_same_trials_and_resu
     out = table / "rehearsal"
     times = (out / "step_times.json").read_text()
     reports = {p: p.stat().st_mtime_ns for p in (out / "reports").rglob("*.json")}
-    assert len(reports) == 4 and json.loads((out / "step_commits.json").read_text()).keys() == json.loads(times).keys()
+    assert (
+        len(reports) == len(ROWS) * len(SEEDS) * len(paths)
+        and json.loads((out / "step_commits.json").read_text()).keys() == json.loads(times).keys()
+    )
 
     again = rehearse(table, tmp_path, paths)  # nothing to redo
     assert (out / "step_times.json").read_text() == times
@@ -96,10 +104,18 @@ def test_rehearsal_runs_igen_eval_and_the_mujoco_arm_on_the_same_trials_and_resu
     assert again["results"] == result["results"]
 
     # an interrupted step (no report) is redone, alone
-    (out / "reports" / "igen" / "rendered.json").unlink()
+    (out / "reports" / "igen" / "seed8" / "rendered.json").unlink()
     rehearse(table, tmp_path, paths)
     redone = json.loads((out / "step_times.json").read_text())
-    assert [s for s, t in redone.items() if t != json.loads(times)[s]] == ["rendered_igen"]
+    assert [s for s, t in redone.items() if t != json.loads(times)[s]] == ["rendered_igen_seed8"]
+
+    # one training seed, in a rehearsal of its own (a resumed one refuses other seeds)
+    with pytest.raises(ConfigError, match=r"seeds: \[7, 8\] -> \[8\]"):
+        rehearse(table, tmp_path, paths, seeds=[8])
+    alone = rehearse(table, tmp_path, ["eval"], seeds=[8], output_dir=str(tmp_path / "seed8"))
+    check_report(alone, table, tmp_path, ["eval"], seeds=[8])
+    with pytest.raises(ConfigError, match=r"--seeds: \[9\] are not among the table's training seeds \[7, 8\]"):
+        rehearse(table, tmp_path, ["eval"], seeds=[9], output_dir=str(tmp_path / "seed9"))
 
 
 @pytest.mark.realtime
@@ -120,7 +136,7 @@ def test_rehearsal_runs_franky_on_franky_sim_started_by_itself(bc_rnn_checkpoint
 def test_a_resumed_rehearsal_refuses_settings_that_change_finished_steps(tmp_path):
     from igen_lerobot.experiments.rehearsal import check_resumed
 
-    settings = {"table_dir": "t", "seed": 0, "trial_seed": 1, "trials": 20, "max_steps": 200, "device": "cpu"}
+    settings = {"table_dir": "t", "seeds": [0], "trial_seed": 1, "trials": 20, "max_steps": 200, "device": "cpu"}
     check_resumed(tmp_path, settings)
     check_resumed(tmp_path, settings)
     with pytest.raises(ConfigError, match="trials: 20 -> 5"):
@@ -133,6 +149,8 @@ def test_rehearsal_config_names_the_fix():
     with pytest.raises(ConfigError, match=r"--paths must be distinct names among \['eval', 'rendered', 'franky'\]"):
         RehearsalConfig(table_dir="x", paths=["mujoco"])
     assert RehearsalConfig(table_dir="x", paths=["franky", "eval"]).paths == ["eval", "franky"]
+    with pytest.raises(ConfigError, match=r"--seeds must be distinct training seeds of the table, got \[1, 1\]"):
+        RehearsalConfig(table_dir="x", seeds=[1, 1])
 
 
 def test_a_table_dir_that_is_not_a_block_grasp_table_is_refused(tmp_path):
@@ -162,14 +180,14 @@ def synthetic(successes: dict[str, tuple[int, int, int]], n: int = 20) -> dict:
         }
         sim, real = PAPER[variant]
         label = LABELS.get(variant, "I-Gen")
-        rows.append({"variant": variant, "label": label, "chosen_step": 1500, "paper_sim": sim, "paper_real": real})
+        rows.append({"variant": variant, "label": label, "chosen_steps": [1500], "paper_sim": sim, "paper_real": real})
         rows[-1]["results"] = results
     step_code = {f"{p}_{v}": {"commit": "a" * 40, "dirty": False} for v in successes for p in PATHS}
     return {
         "kind": "rehearsal",
         "task": "block_grasp",
         "name": "block_grasp_rehearsal",
-        "checkpoint_choice": "the one igen-table chose for training seed 1000 (the table's first)",
+        "checkpoint_choice": "the one igen-table chose for each of every training seed of the table (1000)",
         "trials": n,
         "trial_seed": 2_000_003,
         "trial_choice": "the table's test trials (seed 2000003), which no checkpoint choice saw",
@@ -196,7 +214,8 @@ def test_the_page_renders_a_rehearsal_beside_the_papers_columns_with_the_orderin
     )
     page = render_page([(result, "A reading.")])
     assert "## Block Grasp rehearsal: the sim-to-real rows through the deployment paths" in page
-    header = next(line for line in page.splitlines() if line.startswith("| Variant | chosen step |"))
+    header = next(line for line in page.splitlines() if line.startswith("| Variant |"))
+    assert header.startswith("| Variant | chosen steps |")
     assert header.endswith("| paper sim (50) | paper real (10) |") and all(label in header for label in PATHS.values())
     assert "| Base | 1500 | 1/20 (1–24%) | 0/20 (0–16%) | 0/20 (0–16%) | 6% | 0% |" in page
     assert "| I-Gen | 1500 | 20/20 (84–100%) | 19/20 (76–99%) | 18/20 (70–97%) | 100% | 90% |" in page
@@ -226,3 +245,21 @@ def test_the_ordering_rule_names_inversions_and_skips_a_path_some_row_lacks():
     assert f"- {PATHS['eval']}: does not hold (Source Int below Base)." in page
     assert f"- {PATHS['franky']}: not measured on every row." in page
     assert "| Base | 1500 | 3/20 (5–36%) | 3/20 (5–36%) | – |" in page
+
+
+def test_a_cell_pools_the_training_seeds_and_shows_each_seeds_count():
+    from igen_lerobot.evaluation.trials import wilson_interval
+
+    result = synthetic({"base": (1, 0, 0), "igen": (20, 19, 18)})
+    igen = result["rows"][1]
+    igen["chosen_steps"] = [2000, 2000, 1500]
+    per_seed = [
+        {"seed": s, "chosen_step": 2000, "successes": k, "trials": 20} for s, k in ((1000, 19), (1001, 16), (1002, 15))
+    ]
+    igen["results"]["franky"] = {"successes": 50, "trials": 60, "success_rate": 50 / 60}
+    igen["results"]["franky"] |= {"ci95": list(wilson_interval(50, 60)), "per_seed": per_seed}
+    page = render_page([(result, "")])
+    assert (
+        "| I-Gen | 2000, 2000, 1500 | 20/20 (84–100%) | 19/20 (76–99%) | 50/60 (72–91%) [19, 16, 15] | 100% | 90% |"
+        in page
+    )

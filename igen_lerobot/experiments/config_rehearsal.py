@@ -18,17 +18,19 @@ PATHS = {
 class RehearsalConfig:
     """Which table, which rows, how many trials, which paths.
 
-    ``--table_dir`` is a finished ``igen-table --task=block_grasp`` output dir. Each row's checkpoint
-    is the one the table chose (best on its validation trials) for the training seed ``--seed``
-    (default: the table's first). The trials default to the table's test trials (``--trial_seed``:
-    its ``test_seed``), which no checkpoint choice has seen; every path runs the same ones.
+    ``--table_dir`` is a finished ``igen-table --task=block_grasp`` output dir. Per row, the checkpoint
+    the table chose (best on its validation trials) for each training seed of ``--seeds`` runs (default:
+    every seed of the table, so that a row is measured over its seeds as the table's rows are; one seed
+    through franky varies by several trials between seeds and between runs, docs/benchmarks.md). The
+    trials default to the table's test trials (``--trial_seed``: its ``test_seed``), which no checkpoint
+    choice has seen; every path and every training seed runs the same ones.
     """
 
     table_dir: str = ""
     rows: list[str] | None = None  # default: the rows of the paper's sim-to-real table (those with a real number)
     trials: int = 20
     paths: list[str] = field(default_factory=lambda: list(PATHS))
-    seed: int | None = None  # the training seed whose chosen checkpoints run; default: the table's first
+    seeds: list[int] | None = None  # the training seeds whose chosen checkpoints run; default: all the table's
     trial_seed: int | None = None  # default: the table's test_seed
     max_steps: int = 200  # igen-eval's episode length and igen-deploy's --max_steps alike [steps at 20 Hz]
     device: str | None = None  # --policy.device; default: the table's training device
@@ -49,5 +51,7 @@ class RehearsalConfig:
         for name in ("trials", "max_steps"):
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
+        if self.seeds is not None and (not self.seeds or len(set(self.seeds)) != len(self.seeds)):
+            raise ConfigError(f"--seeds must be distinct training seeds of the table, got {self.seeds}")
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")

@@ -1,7 +1,8 @@
 """The rehearsal table: a finished Block Grasp table's chosen checkpoints through igen-eval and the deployment paths.
 
 Per row of the paper's sim-to-real table (Base, Source Int, MG Demo, I-Gen − Policy, I-Gen), the
-checkpoint the table chose for one training seed runs on the same N trials through three paths:
+checkpoint the table chose for each of its training seeds runs on the same N trials through three
+paths (a row's cell pools its seeds, each seed's count shown beside it):
 
 - ``eval``: ``igen-eval``, the training simulator's own rollout;
 - ``rendered``: ``igen-deploy`` on the MuJoCo arm with a simulated D415 through the real ICP code;
@@ -39,7 +40,7 @@ logger = logging.getLogger(__name__)
 
 TASK = "block_grasp"  # the only task the cameras perceive, and the paper's sim-to-real task
 # settings whose change would mix two protocols in one rehearsal (the rows and paths may grow)
-FIXED = ("table_dir", "seed", "trial_seed", "trials", "max_steps", "device")
+FIXED = ("table_dir", "seeds", "trial_seed", "trials", "max_steps", "device")
 
 
 def read_table_config(table_dir: Path) -> dict:
@@ -60,14 +61,15 @@ def resolved_settings(cfg: RehearsalConfig, table: dict) -> dict:
     """The settings the steps run with, defaults taken from the table; checked against a resumed run's."""
     settings = {
         "table_dir": str(Path(cfg.table_dir).resolve()),
-        "seed": cfg.seed if cfg.seed is not None else table["train_seeds"][0],
+        "seeds": list(cfg.seeds) if cfg.seeds is not None else list(table["train_seeds"]),
         "trial_seed": cfg.trial_seed if cfg.trial_seed is not None else table["test_seed"],
         "trials": cfg.trials,
         "max_steps": cfg.max_steps,
         "device": cfg.device or table["train"]["device"],
     }
-    if settings["seed"] not in table["train_seeds"]:
-        raise ConfigError(f"--seed={settings['seed']} is not one of the table's training seeds {table['train_seeds']}")
+    unknown = [seed for seed in settings["seeds"] if seed not in table["train_seeds"]]
+    if unknown:
+        raise ConfigError(f"--seeds: {unknown} are not among the table's training seeds {table['train_seeds']}")
     return settings
 
 
@@ -127,8 +129,8 @@ def run_step(runner: StepRunner, name: str, command: list[str], report: Path) ->
         raise
 
 
-def path_result(path: str, report: dict) -> dict:
-    """successes/trials, interval, per-trial outcomes and seeds of one path's report."""
+def seed_result(path: str, report: dict) -> dict:
+    """successes/trials, per-trial outcomes, trial seeds and faults of one (row, training seed, path) report."""
     if path == "eval":
         best = report["best"]
         per_trial = list(best["per_trial"])
@@ -138,15 +140,33 @@ def path_result(path: str, report: dict) -> dict:
         per_trial = [trial["success"] for trial in report["per_trial"]]
         seeds = report["trial_seeds"]
         faults = report["deployment"]["faults"]
-    successes, trials = sum(per_trial), len(per_trial)
+    return {
+        "successes": sum(per_trial),
+        "trials": len(per_trial),
+        "per_trial": per_trial,
+        "trial_seeds": seeds,
+        "faults": faults,
+    }
+
+
+def pooled_result(per_seed: dict[int, dict], chosen_steps: dict[int, int]) -> dict:
+    """A row's cell on one path: its training seeds' trials pooled, with a Wilson interval, and each seed's count."""
+    successes = sum(r["successes"] for r in per_seed.values())
+    trials = sum(r["trials"] for r in per_seed.values())
+    trial_seeds = {json.dumps(r["trial_seeds"]) for r in per_seed.values()}
+    if len(trial_seeds) != 1:
+        raise ConfigError("the training seeds' reports ran different trials; delete the rehearsal's reports and rerun")
     return {
         "successes": successes,
         "trials": trials,
         "success_rate": successes / trials,
         "ci95": list(wilson_interval(successes, trials)),
-        "per_trial": per_trial,
-        "trial_seeds": seeds,
-        "faults": faults,
+        "trial_seeds": json.loads(trial_seeds.pop()),
+        "faults": [fault for r in per_seed.values() for fault in r["faults"]],
+        "per_seed": [
+            {"seed": seed, "chosen_step": chosen_steps[seed], **{k: r[k] for k in ("successes", "trials", "per_trial")}}
+            for seed, r in per_seed.items()
+        ],
     }
 
 
@@ -161,10 +181,12 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
     out = Path(cfg.output_dir) if cfg.output_dir else table_dir / "rehearsal"
     check_resumed(out, settings)
     runner = StepRunner(out, cfg.in_process)
-    chosen = {row: chosen_checkpoint(table_dir, row, settings["seed"]) for row in rows}
+    seeds = settings["seeds"]
+    chosen = {(row, seed): chosen_checkpoint(table_dir, row, seed) for row in rows for seed in seeds}
+    which = "every training seed of the table" if seeds == table["train_seeds"] else "training seeds chosen by --seeds"
     choice = (
-        f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for training seed "
-        f"{settings['seed']}" + (" (the table's first)" if settings["seed"] == table["train_seeds"][0] else "")
+        f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for each of "
+        f"{which} ({', '.join(map(str, seeds))}); a cell pools their trials"
     )
     trial_choice = (
         f"the table's test trials (seed {settings['trial_seed']}), which no checkpoint choice saw"
@@ -173,16 +195,18 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
     )
     print(f"checkpoints: per row, {choice}; trials: {settings['trials']} of {trial_choice}")
 
-    def report_of(row: str, path: str) -> Path:
-        return out / "reports" / row / f"{path}.json"
+    def report_of(row: str, seed: int, path: str) -> Path:
+        return out / "reports" / row / f"seed{seed}" / f"{path}.json"
 
     def run_path(path: str) -> None:
         for row in rows:
-            command = path_command(runner, path, chosen[row][1], settings, report_of(row, path), cfg)
-            run_step(runner, f"{path}_{row}", command, report_of(row, path))
+            for seed in seeds:
+                report = report_of(row, seed, path)
+                command = path_command(runner, path, chosen[row, seed][1], settings, report, cfg)
+                run_step(runner, f"{path}_{row}_seed{seed}", command, report)
 
     for path in cfg.paths:
-        pending = any(not report_of(row, path).exists() for row in rows)
+        pending = any(not report_of(row, seed, path).exists() for row in rows for seed in seeds)
         if path == "franky" and pending:
             from lerobot_robot_igen.arm.franky_sim_server import running  # the hardware extra, needed here only
 
@@ -194,13 +218,19 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
 
     result_rows = []
     for row in rows:
-        results = {p: path_result(p, json.loads(report_of(row, p).read_text())) for p in cfg.paths}
+        steps = {seed: chosen[row, seed][0] for seed in seeds}
+        results = {
+            p: pooled_result(
+                {seed: seed_result(p, json.loads(report_of(row, seed, p).read_text())) for seed in seeds}, steps
+            )
+            for p in cfg.paths
+        }
         result_rows.append(
             {
                 "variant": row,
                 "label": variant_label(row),
-                "chosen_step": chosen[row][0],
-                "checkpoint": str(chosen[row][1]),
+                "chosen_steps": [steps[seed] for seed in seeds],
+                "checkpoints": [str(chosen[row, seed][1]) for seed in seeds],
                 "paper_sim": paper.success.get(row),
                 "paper_real": paper.real.get(row),
                 "results": results,
@@ -220,7 +250,7 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
             "test_seed": table["test_seed"],
             "randomize": randomize,
         },
-        "seed": settings["seed"],
+        "seeds": seeds,
         "checkpoint_choice": choice,
         "trial_seed": settings["trial_seed"],
         "trial_choice": trial_choice,
@@ -249,12 +279,11 @@ def rehearse_command(cfg: RehearsalConfig) -> dict:
     result = run_rehearsal(cfg)
     for row in result["rows"]:
         cells = ", ".join(
-            f"{p} {r['successes']}/{r['trials']} ({100 * r['ci95'][0]:.0f}-{100 * r['ci95'][1]:.0f}%)"
+            f"{p} {r['successes']}/{r['trials']} ({100 * r['ci95'][0]:.0f}-{100 * r['ci95'][1]:.0f}%; per seed "
+            f"{'/'.join(str(s['successes']) for s in r['per_seed'])})"
             for p, r in row["results"].items()
         )
-        print(
-            f"{row['label']:>16} (step {row['chosen_step']}): {cells}; paper sim {row['paper_sim']}, "
-            f"real {row['paper_real']}"
-        )
+        steps = "/".join(map(str, row["chosen_steps"]))
+        print(f"{row['label']:>16} (steps {steps}): {cells}; paper sim {row['paper_sim']}, real {row['paper_real']}")
     print(f"Wrote {cfg.results} and {results_folder(Path(cfg.results)) / (result['name'] + '.json')}")
     return result

@@ -1,8 +1,9 @@
 """The rehearsal table's section of the results page, rendered from its JSON (``igen-rehearse``).
 
-Per row: the chosen checkpoint's successes on each path (igen-eval, the MuJoCo arm with a rendered
-D415 and ICP, franky on franky-sim) with Wilson 95% intervals, beside the paper's simulation and
-real-robot columns; then, per path, whether the rows keep the order of the paper's real column.
+Per row: its chosen checkpoints' successes on each path (igen-eval, the MuJoCo arm with a rendered
+D415 and ICP, franky on franky-sim), the training seeds' trials pooled with a Wilson 95% interval and
+each seed's count beside it, next to the paper's simulation and real-robot columns; then, per path,
+whether the rows keep the order of the paper's real column.
 """
 
 from __future__ import annotations
@@ -46,7 +47,17 @@ def _cell(entry: dict | None) -> str:
     if entry is None:
         return "–"
     low, high = entry["ci95"]
-    return f"{entry['successes']}/{entry['trials']} ({100 * low:.0f}–{100 * high:.0f}%)"
+    cell = f"{entry['successes']}/{entry['trials']} ({100 * low:.0f}–{100 * high:.0f}%)"
+    per_seed = entry.get("per_seed") or []
+    if len(per_seed) > 1:
+        cell += " [" + ", ".join(str(s["successes"]) for s in per_seed) + "]"
+    return cell
+
+
+def _steps(row: dict) -> str:
+    """The chosen step per training seed (a rehearsal of one seed before multi-seed rows: its one step)."""
+    steps = row.get("chosen_steps") or [row["chosen_step"]]
+    return ", ".join(map(str, steps))
 
 
 def _pct(value: int | None) -> str:
@@ -76,12 +87,13 @@ def render_rehearsal(result: dict, notes: str = "") -> list[str]:
         f"## {result['task'].replace('_', ' ').title()} rehearsal{generated}: the sim-to-real rows through the "
         "deployment paths",
         "",
-        f"Each row's checkpoint is {result['checkpoint_choice']}. Every path runs the same "
+        f"Each row's checkpoint is {result['checkpoint_choice']}. Every path and seed runs the same "
         f"{result['trials']} trials, {result['trial_choice']}, episodes of at most {result['max_steps']} steps; "
-        "each cell is successes/trials and its Wilson 95% interval. The paper's columns are its own "
+        "each cell is successes/trials with its Wilson 95% interval, and [each training seed's successes] "
+        "where there are several. The paper's columns are its own "
         f"policies: {paper['sim_trials']} trials in simulation, {paper['real_trials']} on a real Franka.",
         "",
-        "| Variant | chosen step | "
+        "| Variant | chosen steps | "
         + " | ".join(result["paths"][p] for p in paths)
         + f" | paper sim ({paper['sim_trials']}) | paper real ({paper['real_trials']}) |",
         "|---|---|" + "---|" * len(paths) + "---|---|",
@@ -89,7 +101,7 @@ def render_rehearsal(result: dict, notes: str = "") -> list[str]:
     for row in result["rows"]:
         cells = " | ".join(_cell(row["results"].get(p)) for p in paths)
         paper_cells = f"{_pct(row['paper_sim'])} | {_pct(row['paper_real'])}"
-        lines.append(f"| {row['label']} | {row['chosen_step']} | {cells} | {paper_cells} |")
+        lines.append(f"| {row['label']} | {_steps(row)} | {cells} | {paper_cells} |")
     ranked = sorted((r for r in result["rows"] if r["paper_real"] is not None), key=lambda r: r["paper_real"])
     lines += [
         "",

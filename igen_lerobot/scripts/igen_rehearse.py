@@ -7,11 +7,12 @@ Examples::
     # re-renders docs/results.md
     igen-rehearse --table_dir=outputs/table
 
-    # two rows, igen-eval and the MuJoCo arm with a rendered D415 + ICP only, the second training seed
-    igen-rehearse --table_dir=outputs/table --rows='[base,igen]' --paths='[eval,rendered]' --seed=1
+    # two rows, igen-eval and the MuJoCo arm with a rendered D415 + ICP only, one training seed
+    igen-rehearse --table_dir=outputs/table --rows='[base,igen]' --paths='[eval,rendered]' --seeds='[1001]'
 
-Each row's checkpoint is the one the table chose for its first training seed (``--seed``); every
-path runs the same trials. franky-sim is started (on ``--franky_host``) and stopped here. Re-running
+Per row, the checkpoint the table chose for each of its training seeds runs (``--seeds``: some of
+them), and a cell pools their trials; every path and seed runs the same trials. franky-sim is
+started (on ``--franky_host``) and stopped here. Re-running
 resumes: finished (row, path) steps are reused (needs the hardware extra and tools/franky_sim/.venv:
 ``make setup``).
 """
