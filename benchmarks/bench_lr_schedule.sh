@@ -5,6 +5,8 @@
 # chosen one tested. The cosine table shares the constant table's data and base policy (links), so
 # the two differ only in the schedule. Seeds run interleaved (constant 1000, cosine 1000, constant
 # 1001, ...) so that a stopped study has pairs to compare; rerun the script to resume it.
+# Cosine became BC-RNN's default after this study; the study's own runs were made while constant was
+# (their table_config.json records no extra_args; each checkpoint's config.json records its schedule).
 #
 #   nice -n 10 bash benchmarks/bench_lr_schedule.sh [OUT_ROOT]      # default outputs/
 set -euo pipefail
@@ -21,7 +23,7 @@ table() {  # output dir, seeds, extra igen-table flags...
 }
 mkdir -p "$constant" "$cosine/train"
 for seeds in '[1000]' '[1000,1001]' '[1000,1001,1002]'; do
-  table "$constant" "$seeds"
+  table "$constant" "$seeds" '--train.extra_args=[--policy.lr_schedule=constant]'
   ln -sfn "$(realpath "$constant/data")" "$cosine/data"
   ln -sfn "$(realpath "$constant/train/base")" "$cosine/train/base"
   table "$cosine" "$seeds" '--train.extra_args=[--policy.lr_schedule=cosine]'

@@ -23,7 +23,7 @@ LR_SCHEDULES = ("constant", "cosine")
 @PreTrainedConfig.register_subclass("bc_rnn")
 @dataclass
 class BCRNNConfig(PreTrainedConfig):
-    """BC-RNN hyperparameters (robomimic ``bc_rnn`` low-dim defaults, lr 1e-3)."""
+    """BC-RNN hyperparameters (robomimic ``bc_rnn`` low-dim defaults, lr 1e-3, annealed by a cosine schedule)."""
 
     n_obs_steps: int = 1
     horizon: int = 10  # training sequence length and rollout RNN reset period (robomimic seq_length)
@@ -44,9 +44,11 @@ class BCRNNConfig(PreTrainedConfig):
     optimizer_lr: float = 1e-3
     optimizer_weight_decay: float = 0.0
     optimizer_grad_clip_norm: float = 1e6  # robomimic does not clip gradients
-    # "constant" (robomimic's default) or "cosine": anneal the rate to zero over lerobot-train's --steps,
-    # so the last checkpoints stop swinging with the last batches (docs/results.md, reproducibility)
-    lr_schedule: str = "constant"
+    # "cosine" anneals the rate to zero over lerobot-train's --steps, so the last checkpoints stop swinging
+    # with the last batches; "constant" is robomimic's. Cosine is the default since the schedule study
+    # (docs/results.md, reproducibility: Nut Insertion I-Gen, 3 training seeds, held-out test trials
+    # 29% against 17%, validation overstating the test by 6 points against 12, last swing 2 against 12)
+    lr_schedule: str = "cosine"
 
     def __post_init__(self) -> None:
         super().__post_init__()
