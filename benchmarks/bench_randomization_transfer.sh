@@ -16,6 +16,8 @@
 # randomised row's training seed; another seed trains on the same data into train/igen_seed<N> and
 # validates, tests and rehearses into files with the same suffix (the plain checkpoint stays seed 1000's).
 # REHEARSE=0 stops after the test trials: train beside other jobs, rehearse later on an idle machine.
+# RUN_SUFFIX names the run's files instead of _seed<N> (e.g. _cosine_seed1001 for a run under another
+# training setting, TRAIN_ARGS, given to lerobot-train: TRAIN_ARGS=--policy.lr_schedule=cosine).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
@@ -25,6 +27,8 @@ setting=${4:-all}
 train_seed=${TRAIN_SEED:-1000}
 suffix=""
 [ "$train_seed" = 1000 ] || suffix=_seed$train_seed
+suffix=${RUN_SUFFIX:-$suffix}
+read -r -a train_args <<< "${TRAIN_ARGS:-}"
 bin=.venv/bin
 source benchmarks/randomization_settings.sh
 [ -n "${RANDOMIZE_SETTINGS[$setting]+set}" ] && [ "$setting" != none ] \
@@ -53,7 +57,7 @@ run=$out/train/igen$suffix
 step "train$suffix" "$run/checkpoints/002000/pretrained_model/config.json" "$bin/lerobot-train" --policy.type=bc_rnn \
   --policy.device=cpu --policy.push_to_hub=false --dataset.repo_id=local/train_igen \
   --dataset.root="$out/data/train_igen" --output_dir="$run" --steps=2000 --batch_size=100 --num_workers=2 \
-  --save_freq=500 --seed="$train_seed" --wandb.enable=false
+  --save_freq=500 --seed="$train_seed" --wandb.enable=false "${train_args[@]}"
 validation=$out/eval/validation$suffix.json
 test=$out/eval/test$suffix.json
 step "validate$suffix" "$validation" "$bin/igen-eval" --env.type=block_grasp --train_dir="$run" \
