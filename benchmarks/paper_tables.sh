@@ -8,6 +8,11 @@
 #   nice -n 10 bash benchmarks/paper_tables.sh nut_insertion   # the tables named
 #   DRY_RUN=true bash benchmarks/paper_tables.sh coffee        # the commands each would run
 #
+# block_grasp_randomized is the Block Grasp table generated on randomised arms (the data that
+# transfer, docs/benchmarks.md), and block_grasp_randomized_rehearsal runs its sim-to-real rows through
+# igen-eval, the MuJoCo arm with a rendered D415 and franky on franky-sim (igen-rehearse, every
+# training seed; franky runs in real time, so nothing else should run beside it).
+#
 # Every row of every table trains the same way: TRAIN (the in-hand tasks and Nut-and-Peg train 5000
 # steps, Block Grasp the paper's 2000) plus PROTOCOL, the settings every table shares.
 set -euo pipefail
@@ -16,6 +21,9 @@ root=${OUT_ROOT:-outputs/tables}
 bin=.venv/bin
 PROTOCOL=(${PROTOCOL:-})
 long=(--train.steps=5000 --train.save_freq=1000)
+# the four arm randomisations of benchmarks/randomization_settings.sh, as igen-table's --randomize list
+RANDOMIZE='["--env.randomize.kp_scale=[0.5,1.5]","--env.randomize.latency=[0,0.04]","--env.randomize.hand_tilt_deg=3","--env.randomize.eef_pos_noise=0.001"]'
+REHEARSALS=(block_grasp_randomized_rehearsal)
 declare -A TABLES=(
   [block_grasp]="--task=block_grasp"
   [nut_insertion]="--task=nut_insertion ${long[*]}"
@@ -25,18 +33,29 @@ declare -A TABLES=(
   [coffee]="--task=coffee ${long[*]}"
   [two_piece_assembly_scaling]="--task=two_piece_assembly --table=scaling ${long[*]}"
   [nut_and_peg]="--task=nut_and_peg ${long[*]}"
+  [block_grasp_randomized]="--task=block_grasp --randomize=${RANDOMIZE}"
 )
-ORDER=(block_grasp nut_insertion nut_insertion_contact_position two_piece_assembly coffee
-  two_piece_assembly_direction two_piece_assembly_scaling nut_and_peg)
+ORDER=(block_grasp nut_insertion nut_insertion_contact_position block_grasp_randomized
+  block_grasp_randomized_rehearsal two_piece_assembly coffee two_piece_assembly_direction
+  two_piece_assembly_scaling nut_and_peg)
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=("${ORDER[@]}")
+is_rehearsal() { [[ " ${REHEARSALS[*]} " == *" $1 "* ]]; }
 for name in "${names[@]}"; do
-  [ -n "${TABLES[$name]+set}" ] || { echo "unknown table '$name'; one of: ${ORDER[*]}"; exit 2; }
+  [ -n "${TABLES[$name]+set}" ] || is_rehearsal "$name" || { echo "unknown table '$name'; one of: ${ORDER[*]}"; exit 2; }
 done
 mkdir -p "$root"
 for name in "${names[@]}"; do
-  read -r -a flags <<< "${TABLES[$name]}"
-  command=("$bin/igen-table" "${flags[@]}" "${PROTOCOL[@]}" --output_dir="$root/$name" --dry_run="${DRY_RUN:-false}")
+  if is_rehearsal "$name"; then
+    table=$root/${name%_rehearsal}
+    command=("$bin/igen-rehearse" --table_dir="$table")
+    if [ "${DRY_RUN:-false}" = true ]; then echo "${command[*]}"; continue; fi
+    [ -e "$table/table_config.json" ] && [ -n "$(ls "$table"/results/*.json 2>/dev/null)" ] \
+      || { echo "$(date +%T) $name: its table $table is not finished; run that first"; exit 1; }
+  else
+    read -r -a flags <<< "${TABLES[$name]}"
+    command=("$bin/igen-table" "${flags[@]}" "${PROTOCOL[@]}" --output_dir="$root/$name" --dry_run="${DRY_RUN:-false}")
+  fi
   echo "$(date +%T) $name: ${command[*]}"
   if [ "${DRY_RUN:-false}" = true ]; then "${command[@]}"; else "${command[@]}" >> "$root/$name.log" 2>&1; fi
 done
