@@ -187,7 +187,7 @@ def synthetic(successes: dict[str, tuple[int, int, int]], n: int = 20) -> dict:
         "kind": "rehearsal",
         "task": "block_grasp",
         "name": "block_grasp_rehearsal",
-        "checkpoint_choice": "the one igen-table chose for each of every training seed of the table (1000)",
+        "checkpoint_choice": "the one igen-table chose for each training seed of the table (1000)",
         "trials": n,
         "trial_seed": 2_000_003,
         "trial_choice": "the table's test trials (seed 2000003), which no checkpoint choice saw",

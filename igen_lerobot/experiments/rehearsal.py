@@ -183,9 +183,9 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
     runner = StepRunner(out, cfg.in_process)
     seeds = settings["seeds"]
     chosen = {(row, seed): chosen_checkpoint(table_dir, row, seed) for row in rows for seed in seeds}
-    which = "every training seed of the table" if seeds == table["train_seeds"] else "training seeds chosen by --seeds"
+    which = "of the table" if seeds == table["train_seeds"] else "given by --seeds"
     choice = (
-        f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for each of "
+        f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for each training seed "
         f"{which} ({', '.join(map(str, seeds))}); a cell pools their trials"
     )
     trial_choice = (
