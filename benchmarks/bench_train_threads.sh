@@ -12,7 +12,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 data=${1:?usage: bench_train_threads.sh DATASET_ROOT [STEPS] [OUT]}
 steps=${2:-400}
 out=${3:-outputs/bench_train_threads}
-rm -rf "$out" && mkdir -p "$out"
+mkdir -p "$out" && rm -rf "$out"/{default,one_thread,pair_a,pair_b} # its own runs only
 train() {  # name seed [env...]
   local name=$1 seed=$2; shift 2
   env "$@" .venv/bin/lerobot-train --policy.type=bc_rnn --policy.device=cpu --policy.push_to_hub=false \

@@ -50,7 +50,8 @@ def eval_trace(cfg, trial: int):
     return success, steps, policy.observations, policy.actions
 
 
-def deploy_trace(cfg, trial: int):
+def deploy_last_trial(cfg, trial: int) -> tuple[dict, list]:
+    """igen-deploy's trials 0..``trial`` (trial i is igen-eval's trial i); the last one's outcome and step records."""
     from lerobot_robot_igen.deploy.trials import deploy
 
     records = []
@@ -58,8 +59,11 @@ def deploy_trace(cfg, trial: int):
     report = deploy(cfg, on_step=records.append)
     # the last trial's records: each trial's steps count up from the same first step again
     first_step = min(r.step for r in records)
-    ours = records[max(i for i, r in enumerate(records) if r.step == first_step) :]
-    outcome = report["per_trial"][-1]
+    return report["per_trial"][-1], records[max(i for i, r in enumerate(records) if r.step == first_step) :]
+
+
+def deploy_trace(cfg, trial: int):
+    outcome, ours = deploy_last_trial(cfg, trial)
     return outcome["success"], outcome["steps"], [r.observation for r in ours], [r.action for r in ours], ours
 
 

@@ -40,20 +40,17 @@ def step_row(rec) -> dict:
 
 def trace(checkpoint: str, trial: int, deploy_flags: list[str]) -> dict:
     import draccus
+    from deploy_vs_eval_trace import deploy_last_trial  # beside this script
 
     from lerobot_robot_igen.deploy.config_deploy import DeployConfig
-    from lerobot_robot_igen.deploy.trials import deploy
 
-    cfg = draccus.parse(DeployConfig, args=[f"--policy.path={checkpoint}", *deploy_flags, f"--trials={trial + 1}"])
-    records = []
-    report = deploy(cfg, on_step=records.append)
-    first_step = min(r.step for r in records)
-    last_trial = records[max(i for i, r in enumerate(records) if r.step == first_step) :]
+    cfg = draccus.parse(DeployConfig, args=[f"--policy.path={checkpoint}", *deploy_flags])
+    outcome, last_trial = deploy_last_trial(cfg, trial)
     return {
         "checkpoint": checkpoint,
         "trial": trial,
         "flags": deploy_flags,
-        "outcome": report["per_trial"][-1],
+        "outcome": outcome,
         "steps": [step_row(r) for r in last_trial],
     }
 
