@@ -76,6 +76,8 @@ def check_report(result: dict, table: Path, tmp_path: Path, paths: list[str], se
     assert f"({', '.join(map(str, seeds))}); a cell pools their trials" in result["checkpoint_choice"]
     assert result["trial_choice"].startswith("the table's test trials (seed 2000003)")
     assert set(result["step_times_s"]) == {f"{p}_{row}_seed{s}" for row in ROWS for p in paths for s in seeds}
+    assert set(result["step_cpu_s"]) == set(result["step_times_s"])
+    assert all(t > 0 for t in result["step_cpu_s"].values())
     page = (tmp_path / "results.md").read_text()
     steps = ", ".join(["3"] * len(seeds))
     assert "rehearsal: the sim-to-real rows" in page and f"| I-Gen | {steps} |" in page

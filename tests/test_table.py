@@ -78,6 +78,12 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     tools = {c["command"].split()[0] for c in report["commands"]}
     assert tools == {"igen-collect", "igen-generate", "igen-merge", "lerobot-train", "igen-eval"}
     assert "lerobot-train --policy.type=bc_rnn" in markdown
+    # every step's CPU time is recorded beside its wall time: a step runs code, so it costs CPU, and
+    # a step cannot use more CPU seconds than the machine's cores give it in its wall time
+    assert set(report["step_cpu_s"]) == set(report["step_times_s"]) == set(report["step_code"])
+    for step, cpu in report["step_cpu_s"].items():
+        assert 0.0 < cpu <= (os.cpu_count() or 1) * report["step_times_s"][step] + 1.0, (step, cpu)
+    assert "- CPU time (all steps): " in markdown
 
     # every variant trained on D plus its own part; the base policy on D alone
     sizes = {row["variant"]: row["dataset"]["episodes"] for row in report["rows"]}

@@ -134,6 +134,20 @@ def machine_line(result: dict) -> str:
     return f"- Machine: steps ran on {len(by_machine)} machines ({parts}; per step in the JSON)."
 
 
+def cpu_line(result: dict) -> str:
+    """The steps' CPU time: what they cost whatever else the machine ran beside them."""
+    cpu = result.get("step_cpu_s") or {}
+    steps = result.get("step_times_s") or {}
+    if not cpu:
+        return "- CPU time: not recorded (the steps ran before it was)."
+    counted = f"{len(cpu)} of {len(steps)} steps" if set(cpu) != set(steps) else "all steps"
+    wall = sum(steps[step] for step in cpu if step in steps)
+    return (
+        f"- CPU time ({counted}): {sum(cpu.values()) / 60:.1f} min over {wall / 60:.1f} min of their wall time "
+        "(on an idle machine the steps keep about 2 cores busy; far less means other work slowed them)."
+    )
+
+
 def provenance_lines(result: dict) -> list[str]:
     """How a recorded run was made: its code versions and machines, its wall time and every command."""
     return [
@@ -141,6 +155,7 @@ def provenance_lines(result: dict) -> list[str]:
         machine_line(result),
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
+        cpu_line(result),
         "",
         "Commands:",
         "",

@@ -23,6 +23,7 @@ import contextlib
 import json
 import logging
 import os
+import resource
 import shlex
 import subprocess
 import sys
@@ -78,6 +79,10 @@ class StepRunner:
         # several sessions still knows how long every step took and which code made it
         self.timings_file = self.out / "step_times.json"
         self.timings: dict[str, float] = _read_json(self.timings_file, {})
+        # step -> CPU seconds (this process and its children): unlike wall time, not stretched by
+        # whatever else the machine ran meanwhile, so a step timed under load still says its cost
+        self.cpu_times_file = self.out / "step_cpu_times.json"
+        self.cpu_times: dict[str, float] = _read_json(self.cpu_times_file, {})
         self.versions_file = self.out / "step_commits.json"
         self.versions: dict[str, dict] = _read_json(self.versions_file, {})
 
@@ -101,7 +106,7 @@ class StepRunner:
         log.parent.mkdir(parents=True, exist_ok=True)
         command = execute or command
         logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), cpu_seconds()
         if self.in_process:
             code = _run_in_process(command, log)
         else:
@@ -110,9 +115,11 @@ class StepRunner:
         if code == 0 and done.exists():
             # a resumed step adds this leg to what earlier legs recorded
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
+            self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
             self.versions[name] = self.code
             self.out.mkdir(parents=True, exist_ok=True)
             self.timings_file.write_text(json.dumps(self.timings, indent=2))
+            self.cpu_times_file.write_text(json.dumps(self.cpu_times, indent=2))
             self.versions_file.write_text(json.dumps(self.versions, indent=2))
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
@@ -134,6 +141,12 @@ class TableRun(StepRunner):
         # column whose validation trials choose the checkpoints
         self.columns = dict(paper.columns) if paper is not None else {}
         self.choose_on = paper.choose_on if paper is not None else ""
+
+
+def cpu_seconds() -> float:
+    """User + system CPU seconds of this process and of its children that have ended."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
 def _read_json(path: Path, default):
@@ -467,6 +480,7 @@ def run_table(cfg: TableConfig) -> dict:
         "commands": run.commands,
         "wall_time_s": time.perf_counter() - start,
         "step_times_s": {step: t for step, t in run.timings.items() if step in ran},
+        "step_cpu_s": {step: t for step, t in run.cpu_times.items() if step in ran},
     }
     results = Path(cfg.results)
     folder = results_folder(results)
