@@ -115,6 +115,36 @@ def test_collect_config_rejects_bad_flags_with_the_fix(args, message):
     assert isinstance(error, ConfigError) and re.search(re.escape(message), str(error))
 
 
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--mode=igen", "--mimicgen.replay.target_noise=0.002"], "--mimicgen.* flags apply to --mode=mimicgen"),
+        (["--mode=igen_no_policy", "--mimicgen.selection=random"], "--mode=igen_no_policy reads --igen.*"),
+        (["--mode=mimicgen", "--igen.replay.target_noise=0.002"], "--mode=mimicgen reads --mimicgen.*"),
+    ],
+)
+def test_generate_refuses_the_other_modes_flags_instead_of_dropping_them(args, message):
+    import re
+
+    import draccus
+
+    from igen_lerobot.core.env_config import known_tasks
+    from igen_lerobot.core.exceptions import ConfigError
+    from igen_lerobot.generation.config_generate import GenerateConfig
+    from igen_lerobot.scripts.cli import find_igen_error
+
+    known_tasks()
+    common = ["--env.type=block_grasp", "--source.root=outputs/x"]
+    with pytest.raises(Exception) as caught:  # noqa: PT011
+        draccus.parse(GenerateConfig, args=[*common, *args])
+    error = find_igen_error(caught.value)
+    assert isinstance(error, ConfigError) and re.search(re.escape(message), str(error))
+    # the flag is taken in its own mode
+    own = "--mode=mimicgen" if "mimicgen" in args[1] else "--mode=igen"
+    cfg = draccus.parse(GenerateConfig, args=[*common, own, args[1]])
+    assert cfg.mode == own.split("=")[1]
+
+
 def test_collect_cli_reports_bad_flags(tmp_path):
     result = run(collect_cmd(tmp_path / "x", 1, mode="demo"))
     assert result.returncode == 2

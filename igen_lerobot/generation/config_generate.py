@@ -71,6 +71,17 @@ class GenerateConfig:
             raise ConfigError(f"--backend must be one of {BACKENDS}, got {self.backend!r}")
         if self.max_attempts < 0:
             raise ConfigError(f"--max_attempts must be >= 0 (0 = 20 x num_episodes), got {self.max_attempts}")
+        # each mode reads one of the two sections: a flag of the other would be silently dropped
+        if self.mode == GenerationMode.MIMICGEN and self.igen != IntervenGenConfig():
+            raise ConfigError(
+                "--igen.* flags apply to --mode=igen and igen_no_policy; --mode=mimicgen reads --mimicgen.* "
+                "(e.g. --mimicgen.replay.target_noise)"
+            )
+        if self.mode != GenerationMode.MIMICGEN and self.mimicgen != MimicGenConfig():
+            raise ConfigError(
+                f"--mimicgen.* flags apply to --mode=mimicgen; --mode={self.mode} reads --igen.* "
+                "(e.g. --igen.replay.target_noise)"
+            )
         if self.policy.path and self.mode != GenerationMode.IGEN:
             raise ConfigError(f"--policy.path only applies to --mode=igen (mode {self.mode} runs no policy)")
 
