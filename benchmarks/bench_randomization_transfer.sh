@@ -18,6 +18,7 @@
 # REHEARSE=0 stops after the test trials: train beside other jobs, rehearse later on an idle machine.
 # RUN_SUFFIX names the run's files instead of _seed<N> (e.g. _cosine_seed1001 for a run under another
 # training setting, TRAIN_ARGS, given to lerobot-train: TRAIN_ARGS=--policy.lr_schedule=cosine).
+# TRAIN_STEPS (default 2000) and SAVE_FREQ (default 500): a longer budget, checkpoints validated as before.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 table=${1:?usage: bench_randomization_transfer.sh TABLE_DIR OUT_DIR [TRIALS]}
@@ -29,6 +30,8 @@ suffix=""
 [ "$train_seed" = 1000 ] || suffix=_seed$train_seed
 suffix=${RUN_SUFFIX:-$suffix}
 read -r -a train_args <<< "${TRAIN_ARGS:-}"
+train_steps=${TRAIN_STEPS:-2000}
+save_freq=${SAVE_FREQ:-500}
 bin=.venv/bin
 source benchmarks/randomization_settings.sh
 [ -n "${RANDOMIZE_SETTINGS[$setting]+set}" ] && [ "$setting" != none ] \
@@ -54,10 +57,11 @@ step igen "$out/data/igen/meta/igen.json" "$bin/igen-generate" --mode=igen --env
 step merge "$out/data/train_igen/meta/igen.json" "$bin/igen-merge" --task=block_grasp \
   "--inputs=[$out/data/base,$out/data/igen]" --dataset.root="$out/data/train_igen"
 run=$out/train/igen$suffix
-step "train$suffix" "$run/checkpoints/002000/pretrained_model/config.json" "$bin/lerobot-train" --policy.type=bc_rnn \
+step "train$suffix" "$(printf '%s/checkpoints/%06d/pretrained_model/config.json' "$run" "$train_steps")" \
+  "$bin/lerobot-train" --policy.type=bc_rnn \
   --policy.device=cpu --policy.push_to_hub=false --dataset.repo_id=local/train_igen \
-  --dataset.root="$out/data/train_igen" --output_dir="$run" --steps=2000 --batch_size=100 --num_workers=2 \
-  --save_freq=500 --seed="$train_seed" --wandb.enable=false "${train_args[@]}"
+  --dataset.root="$out/data/train_igen" --output_dir="$run" --steps="$train_steps" --batch_size=100 --num_workers=2 \
+  --save_freq="$save_freq" --seed="$train_seed" --wandb.enable=false "${train_args[@]}"
 validation=$out/eval/validation$suffix.json
 test=$out/eval/test$suffix.json
 step "validate$suffix" "$validation" "$bin/igen-eval" --env.type=block_grasp --train_dir="$run" \
