@@ -144,7 +144,7 @@ def cpu_line(result: dict) -> str:
     wall = sum(steps[step] for step in cpu if step in steps)
     return (
         f"- CPU time ({counted}): {sum(cpu.values()) / 60:.1f} min over {wall / 60:.1f} min of their wall time "
-        "(on an idle machine the steps keep about 2 cores busy; far less means other work slowed them)."
+        "(other work beside a step lengthens its wall time, not its CPU time; per step in step_cpu_times.json)."
     )
 
 
