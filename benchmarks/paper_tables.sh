@@ -15,8 +15,9 @@
 # steps, every row alike: at Block Grasp's 2000 the randomised I-Gen row passed 47/60 rehearsal
 # trials through franky, at 6000 55/60 (docs/benchmarks.md, "A longer training budget").
 #
-# Every row of every table trains the same way: TRAIN (the in-hand tasks and Nut-and-Peg train 5000
-# steps, Block Grasp the paper's 2000) plus PROTOCOL, the settings every table shares.
+# Every row of a table trains the same way: its budget (the in-hand tasks and Nut-and-Peg train 5000
+# steps, Block Grasp the paper's 2000, Block Grasp on randomised arms 6000) plus PROTOCOL, the
+# settings every table shares.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=${OUT_ROOT:-outputs/tables}
