@@ -157,3 +157,59 @@ def test_a_sampling_checkpoints_trial_is_the_same_whatever_ran_before(bc_rnn_che
         np.testing.assert_array_equal(np.stack(policy.actions), first)
     finally:
         env.close()
+
+
+def test_trials_over_worker_processes_match_one_process(block_grasp_config, block_grasp_env):
+    """``--workers=2`` gives each trial the outcome and step count one process gives (tolerance 0):
+    trial i is run from its own seed whichever worker takes it, and results come back in trial order."""
+    from igen_lerobot.evaluation.parallel import TrialPool
+    from igen_lerobot.training.policy_source import PolicySourceConfig
+
+    here = evaluate(
+        block_grasp_env, block_grasp_config.make_scripted_policy(), "scripted", 6, seed=7, max_steps=200, progress=False
+    )
+    assert len(set(here.per_trial_steps)) > 1  # trials end at different steps: a shuffled order would show
+    with TrialPool(block_grasp_config, workers=2) as pool:
+        spread = pool.evaluate(PolicySourceConfig(), "scripted", 6, seed=7, max_steps=200, progress=False)
+        again = pool.evaluate(PolicySourceConfig(), "scripted", 3, seed=8, max_steps=200, progress=False)
+    assert spread.per_trial == here.per_trial and spread.per_trial_steps == here.per_trial_steps
+    assert spread.successes == here.successes and spread.mean_steps == here.mean_steps
+    other = evaluate(
+        block_grasp_env, block_grasp_config.make_scripted_policy(), "scripted", 3, seed=8, max_steps=200, progress=False
+    )
+    assert again.per_trial_steps == other.per_trial_steps  # a second target in the same pool: its own seeds
+
+
+def test_a_checkpoints_actions_are_the_same_at_one_torch_thread_as_at_two(bc_rnn_checkpoint, block_grasp_config):
+    """Evaluation workers run torch at one thread; a sampling BC-RNN checkpoint must act bit for bit as it
+    does at two (tolerance 0), or ``--workers`` would change a table's numbers."""
+    import numpy as np
+    import torch
+
+    from igen_lerobot.evaluation.trials import rollout
+    from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+    policy = _Recording(make_base_policy(PolicySourceConfig(path=str(bc_rnn_checkpoint)), block_grasp_config))
+    env = block_grasp_config.make_task_env()
+    threads = torch.get_num_threads()
+    actions = {}
+    try:
+        for n in (2, 1):
+            torch.set_num_threads(n)
+            policy.actions.clear()
+            rollout(env, policy, seed=7, max_steps=30)
+            actions[n] = np.stack(policy.actions)
+    finally:
+        torch.set_num_threads(threads)
+        env.close()
+    np.testing.assert_array_equal(actions[1], actions[2])
+
+
+def test_igen_eval_workers_bad_input_names_the_fix():
+    from igen_lerobot.evaluation.config_eval import EvalConfig
+    from igen_lerobot.viz.rerun_log import RerunConfig
+
+    with pytest.raises(ConfigError, match="--workers must be >= 1"):
+        EvalConfig(task="block_grasp", workers=0)
+    with pytest.raises(ConfigError, match="--workers=1"):
+        EvalConfig(task="block_grasp", workers=2, rerun=RerunConfig(mode="save", path="x.rrd"))

@@ -27,6 +27,9 @@ class EvalConfig:
     seed: int = EVAL_SEED
     output: str | None = None  # JSON file for the results
     rerun: RerunConfig = field(default_factory=RerunConfig)  # --rerun.mode=save --rerun.path=x.rrd: log each trial
+    # processes running the trials, one simulation each: the same outcomes for any count, faster up to
+    # one per core
+    workers: int = 1
 
     def __post_init__(self) -> None:
         self.env = resolve_task_env(self.task, self.env)
@@ -36,3 +39,7 @@ class EvalConfig:
             raise ConfigError(f"--n_trials must be >= 1, got {self.n_trials}")
         if self.every < 1:
             raise ConfigError(f"--every must be >= 1, got {self.every}")
+        if self.workers < 1:
+            raise ConfigError(f"--workers must be >= 1, got {self.workers}")
+        if self.workers > 1 and self.rerun.enabled:
+            raise ConfigError("--rerun logs every trial's frames from one process; drop --rerun or pass --workers=1")

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from igen_lerobot.evaluation.checkpoints import best_result, list_checkpoints
 from igen_lerobot.evaluation.config_eval import EvalConfig
+from igen_lerobot.evaluation.parallel import TrialPool
 from igen_lerobot.evaluation.trials import EvalResult, evaluate
 from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
 from igen_lerobot.viz.rerun_log import EpisodeLogger
@@ -36,6 +37,45 @@ def run_eval(cfg: EvalConfig) -> dict:
         ]
     else:
         targets = [(None, cfg.policy)]
+    results = _run_workers(cfg, targets) if cfg.workers > 1 else _run_here(cfg, targets)
+    best = best_result(results)
+    report = {
+        "task": env_cfg.type,
+        "n_trials": cfg.n_trials,
+        "seed": cfg.seed,
+        "corruption": {
+            "type": env_cfg.corruption.type_name,
+            **dataclasses.asdict(env_cfg.corruption),
+        },
+        "reveal": str(env_cfg.reveal),
+        "results": [r.to_json() for r in results],
+        "best": best.to_json(),
+    }
+    if len(results) > 1:
+        print(f"best: {_line(best)}")
+    if cfg.output:
+        out = Path(cfg.output)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(report, indent=2))
+    return report
+
+
+def _run_workers(cfg: EvalConfig, targets: list[tuple[int | None, PolicySourceConfig]]) -> list[EvalResult]:
+    """Each target's trials over ``cfg.workers`` processes, one target after another."""
+    env_cfg = cfg.env
+    results = []
+    with TrialPool(env_cfg, cfg.workers, env_cfg.image_cameras) as pool:
+        for step, source in targets:
+            result = pool.evaluate(source, source.describe(), cfg.n_trials, cfg.seed, env_cfg.episode_length)
+            result.step = step
+            results.append(result)
+            print(_line(result))
+    return results
+
+
+def _run_here(cfg: EvalConfig, targets: list[tuple[int | None, PolicySourceConfig]]) -> list[EvalResult]:
+    """Each target's trials in this process, logged to Rerun when asked."""
+    env_cfg = cfg.env
     env = env_cfg.make_task_env()
     results = []
     viz = EpisodeLogger.open(cfg.rerun, env_cfg.task_spec, "eval")
@@ -68,23 +108,4 @@ def run_eval(cfg: EvalConfig) -> dict:
         env.close()
         if viz is not None:
             viz.close()
-    best = best_result(results)
-    report = {
-        "task": env_cfg.type,
-        "n_trials": cfg.n_trials,
-        "seed": cfg.seed,
-        "corruption": {
-            "type": env_cfg.corruption.type_name,
-            **dataclasses.asdict(env_cfg.corruption),
-        },
-        "reveal": str(env_cfg.reveal),
-        "results": [r.to_json() for r in results],
-        "best": best.to_json(),
-    }
-    if len(results) > 1:
-        print(f"best: {_line(best)}")
-    if cfg.output:
-        out = Path(cfg.output)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(json.dumps(report, indent=2))
-    return report
+    return results

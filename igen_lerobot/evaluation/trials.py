@@ -51,6 +51,7 @@ class EvalResult:
     seconds: float
     per_trial: list[bool] = field(default_factory=list)
     step: int | None = None  # training step of the checkpoint, when known
+    per_trial_steps: list[int] = field(default_factory=list)  # control steps of each trial (older reports: none)
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -121,7 +122,13 @@ def evaluate(
                 on_trial(i, success, n, episode)
             bar.update()
             bar.set_postfix(success=f"{sum(outcomes)}/{len(outcomes)}")
+    return trials_result(name, outcomes, steps, time.perf_counter() - start)
+
+
+def trials_result(name: str, outcomes: list[bool], steps: list[int], seconds: float) -> EvalResult:
+    """The result of trials 0..n-1 from their outcomes and step counts, in trial order."""
     successes = sum(outcomes)
+    trials = len(outcomes)
     return EvalResult(
         policy=name,
         trials=trials,
@@ -129,6 +136,7 @@ def evaluate(
         success_rate=successes / trials,
         ci95=wilson_interval(successes, trials),
         mean_steps=sum(steps) / trials,
-        seconds=time.perf_counter() - start,
-        per_trial=outcomes,
+        seconds=seconds,
+        per_trial=list(outcomes),
+        per_trial_steps=list(steps),
     )

@@ -39,7 +39,7 @@ class TableConfig:
     source_episodes: int = 10  # human (here: scripted-operator) episodes of each kind
     base_demos: int = 1000  # MimicGen demonstrations forming the base dataset D
     generated: int = 1000  # synthetic episodes for MG Demo, I-Gen - Policy and I-Gen
-    workers: int = 2
+    workers: int = 2  # processes of each generation and evaluation step (neither changes its results)
     seed: int = 0
     # generation as domain randomisation: --env.randomize.* flags for every igen-generate step (D and each
     # generated row's data); sources are collected, and every policy evaluated, on the task's own arm.

@@ -315,6 +315,7 @@ def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: i
             f"--n_trials={n_trials}",
             f"--seed={seed}",
             f"--policy.device={cfg.train.device}",
+            f"--workers={cfg.workers}",
             f"--output={report}",
         ),
         report,

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import enum
-import os
 from dataclasses import dataclass, field
 
 from igen_lerobot.core.env_config import TaskEnvConfig
@@ -35,18 +34,6 @@ class GenerationJob:
     policy: PolicySourceConfig = field(default_factory=PolicySourceConfig)
     mimicgen: MimicGenConfig = field(default_factory=MimicGenConfig)
     igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
-
-
-def limit_threads() -> None:
-    """One core per worker: BLAS/OpenMP/torch would otherwise oversubscribe the machine."""
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ[var] = "1"
-    try:
-        import torch
-
-        torch.set_num_threads(1)
-    except ImportError:  # pragma: no cover - torch ships with lerobot
-        pass
 
 
 class AttemptRunner:

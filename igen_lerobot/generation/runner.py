@@ -28,9 +28,10 @@ from multiprocessing.connection import Connection, wait
 from tqdm import tqdm
 
 from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.threads import limit_threads
 from igen_lerobot.datasets.spool import EpisodeSpool
 from igen_lerobot.generation.attempt import Attempt
-from igen_lerobot.generation.job import AttemptRunner, GenerationJob, limit_threads
+from igen_lerobot.generation.job import AttemptRunner, GenerationJob
 
 logger = logging.getLogger(__name__)
 

@@ -1,0 +1,97 @@
+"""Seeded trials spread over worker processes, with the outcomes one process gives: ``igen-eval --workers``.
+
+Trial ``i`` depends only on its seed: the scene, the corruption and the policy's draws are all
+seeded from it (tests/test_evaluation.py), and the policy's actions are the same at one torch
+thread as at two. So ``--workers=k`` returns, trial by trial, what ``--workers=1`` returns; only
+``seconds`` differs. One MuJoCo simulation keeps one core busy, so on a 2-core machine two
+workers nearly halve an evaluation.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+
+from tqdm import tqdm
+
+from igen_lerobot.core.cameras import CameraConfig
+from igen_lerobot.core.env_config import TaskEnvConfig
+from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.core.threads import limit_threads
+from igen_lerobot.evaluation.trials import EvalResult, rollout, trials_result
+from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+# one worker's env, kept across trials, and the policy it loaded last (by its config)
+_worker: dict = {}
+
+
+class EvalWorkerError(IgenError, RuntimeError):
+    """An evaluation worker could not start, or died before its trials finished."""
+
+
+def _start_worker(env_config: TaskEnvConfig, cameras: CameraConfig | None) -> None:  # pragma: no cover
+    limit_threads()
+    _worker.update(env_config=env_config, cameras=cameras, env=env_config.make_task_env(), source=None, policy=None)
+
+
+def _run_trial(  # pragma: no cover
+    source: PolicySourceConfig, seed: int, index: int, max_steps: int
+) -> tuple[int, bool, int]:
+    if _worker["source"] != source:
+        _worker["policy"] = make_base_policy(source, _worker["env_config"])
+        _worker["source"] = source
+    success, steps = rollout(
+        _worker["env"], _worker["policy"], episode_seed(seed, index), max_steps, cameras=_worker["cameras"]
+    )
+    return index, success, steps
+
+
+class TrialPool:
+    """Worker processes, each with its own env, that run one policy's trials at a time; a context manager."""
+
+    def __init__(self, env_config: TaskEnvConfig, workers: int, cameras: CameraConfig | None = None) -> None:
+        if workers < 1:
+            raise ConfigError(f"--workers must be >= 1, got {workers}")
+        # not plain fork: this process has torch's threads, and forking them can deadlock a child
+        context = mp.get_context("forkserver")
+        context.set_forkserver_preload([__name__, type(env_config).__module__])
+        self._executor = ProcessPoolExecutor(
+            max_workers=workers, mp_context=context, initializer=_start_worker, initargs=(env_config, cameras)
+        )
+
+    def __enter__(self) -> TrialPool:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._executor.shutdown(wait=True, cancel_futures=True)
+
+    def evaluate(
+        self, source: PolicySourceConfig, name: str, trials: int, seed: int, max_steps: int, progress: bool = True
+    ) -> EvalResult:
+        """Trials ``0..trials-1`` of ``source``, as :func:`~igen_lerobot.evaluation.trials.evaluate` runs them."""
+        if trials < 1:
+            raise ConfigError(f"eval trials must be >= 1, got {trials}")
+        start = time.perf_counter()
+        futures = [self._executor.submit(_run_trial, source, seed, i, max_steps) for i in range(trials)]
+        outcomes: list[bool | None] = [None] * trials
+        steps = [0] * trials
+        try:
+            with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
+                for future in as_completed(futures):
+                    index, success, n = future.result()
+                    outcomes[index], steps[index] = success, n
+                    bar.update()
+                    bar.set_postfix(success=f"{sum(o is True for o in outcomes)}/{bar.n}")
+        except BrokenProcessPool as error:
+            raise EvalWorkerError(
+                f"an evaluation worker could not start or died while running {name}'s trials (a start error "
+                "is printed above; else killed or out of memory); fix that and rerun, or pass --workers=1 "
+                "to run every trial in this process"
+            ) from error
+        return trials_result(name, [bool(o) for o in outcomes], steps, time.perf_counter() - start)
