@@ -15,11 +15,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.paper import VARIANTS
 from igen_lerobot.datasets.reader import load_episodes
 from igen_lerobot.experiments.config_table import TableConfig
 from igen_lerobot.experiments.provenance import code_version, provenance_problems
 from igen_lerobot.experiments.table_steps import LABELS
+from igen_lerobot.training.config_train import TrainConfig
 
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
 
@@ -75,9 +77,13 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     else:  # CI's clean clone
         assert problems == []
     assert set(report["step_code"]) == {c["step"] for c in report["commands"]}
-    tools = {c["command"].split()[0] for c in report["commands"]}
+    tools = {next(w for w in c["command"].split() if "=" not in w) for c in report["commands"]}
     assert tools == {"igen-collect", "igen-generate", "igen-merge", "lerobot-train", "igen-eval"}
-    assert "lerobot-train --policy.type=bc_rnn" in markdown
+    # every training runs at the table's fixed thread count (the weights differ between counts)
+    trainings = [c["command"] for c in report["commands"] if c["step"].startswith("train_")]
+    assert trainings and all(c.startswith("OMP_NUM_THREADS=2 lerobot-train ") for c in trainings)
+    assert report["config"]["train"]["threads"] == 2
+    assert "OMP_NUM_THREADS=2 lerobot-train --policy.type=bc_rnn" in markdown
     # every step's CPU time is recorded beside its wall time: a step runs code, so it costs CPU, and
     # a step cannot use more CPU seconds than the machine's cores give it in its wall time
     assert set(report["step_cpu_s"]) == set(report["step_times_s"]) == set(report["step_code"])
@@ -186,7 +192,6 @@ def test_superseded_tables_render_with_their_curves():
 
 
 def test_a_resumed_table_refuses_settings_that_change_finished_steps(tmp_path):
-    from igen_lerobot.core.exceptions import ConfigError
     from igen_lerobot.experiments.table import check_resumed_config
 
     out = str(tmp_path / "t")
@@ -201,7 +206,6 @@ def test_a_resumed_table_refuses_settings_that_change_finished_steps(tmp_path):
 
 
 def test_table_config_refuses_seeds_that_break_the_protocol():
-    from igen_lerobot.core.exceptions import ConfigError
 
     assert TableConfig().train_seeds == [1000, 1001, 1002]
     assert TableConfig(train_seeds=[5, 6]).train.seed == 5  # the base policy's seed is the first
@@ -215,7 +219,6 @@ def test_the_data_scaling_table_is_a_named_table_with_sized_rows(tmp_path):
     """2-Piece Assembly's --table=scaling: I-Gen with 200/1000/5000 generated interventions against 100
     operator interventions, each its own dataset made by its unsized row's command with n episodes
     (same seed: the 100 operator interventions begin with the 10 sources), merged with D alike."""
-    from igen_lerobot.core.exceptions import ConfigError
     from igen_lerobot.experiments.table_steps import needed_parts, variant_label, variant_part
 
     cfg = TableConfig(task="two_piece_assembly", table="scaling", output_dir=str(tmp_path / "t"))
@@ -252,9 +255,23 @@ def test_a_table_recorded_before_a_setting_existed_resumes_with_its_default(tmp_
     out = tmp_path / "t"
     check_resumed_config(TableConfig(output_dir=str(out), variants=["base"]))
     recorded = json.loads((out / "table_config.json").read_text())
-    del recorded["table"], recorded["randomize"]
+    del recorded["table"], recorded["randomize"], recorded["train"]["threads"]
     (out / "table_config.json").write_text(json.dumps(recorded))
     check_resumed_config(TableConfig(output_dir=str(out), variants=["base"]))
+    # a nested key recorded before it existed (train.threads) is the count those tables trained with, 2
+    with pytest.raises(ConfigError, match="other settings"):
+        check_resumed_config(TableConfig(output_dir=str(out), variants=["base"], train=TrainConfig(threads=1)))
+
+
+def test_a_table_fixes_its_training_threads_and_a_bad_count_is_refused():
+    """Weights differ between torch thread counts, so every table pins one, given or not (draccus builds
+    --train.* flags on the class defaults, not the table's)."""
+    assert TableConfig().train.threads == 2
+    assert TableConfig(train=TrainConfig(steps=5000)).train.threads == 2
+    assert TableConfig(train=TrainConfig(threads=1)).train.threads == 1
+    assert TrainConfig().threads is None  # igen-loop and plain training keep torch's default
+    with pytest.raises(ConfigError, match="train.threads must be >= 1"):
+        TrainConfig(threads=0)
 
 
 def test_the_main_table_across_tasks_has_a_column_per_task_with_all_seven_rows():
@@ -289,7 +306,6 @@ def test_randomised_generation_reaches_the_generators_only_and_names_its_own_tab
     """--randomize: generation as domain randomisation. Every igen-generate step (D and each generated
     row) gets the flags; sources are collected, and every policy evaluated, on the task's own arm;
     the table is saved under its own name, so it never replaces the plain one; bad flags name the fix."""
-    from igen_lerobot.core.exceptions import ConfigError
     from igen_lerobot.experiments.table import plan
 
     flags = ["--env.randomize.kp_scale=[0.5,1.5]", "--env.randomize.latency=[0,0.04]"]

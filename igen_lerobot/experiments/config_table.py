@@ -15,6 +15,12 @@ VAL_SEED = EVAL_SEED  # the trials earlier tables reported on: they choose check
 TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 
 
+# torch threads of every table's trainings unless --train.threads says otherwise: fixed, so that a machine
+# with more cores trains the same weights; 2, what every earlier table trained with (torch's default on
+# the 2-core machine of docs/results.md)
+TABLE_TRAIN_THREADS = 2
+
+
 @dataclass
 class TableConfig:
     """Sizes follow the paper (10 source episodes, 1000 generated, 50 trials); shrink them for a smoke run.
@@ -80,6 +86,8 @@ class TableConfig:
         if not self.train_seeds or len(set(self.train_seeds)) != len(self.train_seeds):
             raise ConfigError(f"--train_seeds must be a non-empty list of distinct seeds, got {self.train_seeds}")
         self.train.seed = self.train_seeds[0]  # recorded configs then name the seed each run used
+        if self.train.threads is None:
+            self.train.threads = TABLE_TRAIN_THREADS
         if self.val_seed == self.test_seed:
             raise ConfigError(
                 f"--val_seed and --test_seed must differ (both {self.val_seed}): test trials are held out"

@@ -49,7 +49,13 @@ from igen_lerobot.experiments.table_steps import (
     variant_label,
     variant_part,
 )
-from igen_lerobot.training.lerobot_train import final_checkpoint, run_command, step_checkpoint, train_command
+from igen_lerobot.training.lerobot_train import (
+    final_checkpoint,
+    run_command,
+    step_checkpoint,
+    train_command,
+    train_env,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -89,13 +95,22 @@ class StepRunner:
     def data(self, name: str) -> Path:
         return self.out / "data" / name
 
-    def run(self, name: str, command: list[str], done: Path, execute: list[str] | None = None) -> None:
+    def run(
+        self,
+        name: str,
+        command: list[str],
+        done: Path,
+        execute: list[str] | None = None,
+        env: dict[str, str] | None = None,
+    ) -> None:
         """Run ``command`` unless ``done`` exists; its output is appended to ``logs/<name>.log``.
 
         ``execute``, when given, is what actually runs (a training resumed from its checkpoint),
         while ``command`` is what the table records: the command that makes the step from scratch.
+        ``env``: variables the command runs with, recorded in front of it as a shell would take them.
         """
-        shown = shlex.join([Path(command[0]).name, *command[1:]])
+        env = env or {}
+        shown = shlex.join([*(f"{k}={v}" for k, v in env.items()), Path(command[0]).name, *command[1:]])
         self.commands.append({"step": name, "command": shown})
         if self.dry_run:
             return
@@ -108,10 +123,12 @@ class StepRunner:
         logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
         start, cpu_start = time.perf_counter(), cpu_seconds()
         if self.in_process:
-            code = _run_in_process(command, log)
+            code = _run_in_process(command, log, env)
         else:
             with open(log, "a") as sink:
-                code = subprocess.run(command, stdout=sink, stderr=subprocess.STDOUT, env=os.environ.copy()).returncode
+                code = subprocess.run(
+                    command, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
+                ).returncode
         if code == 0 and done.exists():
             # a resumed step adds this leg to what earlier legs recorded
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
@@ -153,8 +170,12 @@ def _read_json(path: Path, default):
     return json.loads(path.read_text()) if path.exists() else default
 
 
-def _run_in_process(command: list[str], log: Path) -> int:
-    """Call the console script's entry point with ``command``'s arguments; its exit status."""
+def _run_in_process(command: list[str], log: Path, env: dict[str, str]) -> int:
+    """Call the console script's entry point with ``command``'s arguments; its exit status.
+
+    ``OMP_NUM_THREADS`` in ``env`` sets torch's threads for the call (the variable itself is read once,
+    when torch starts).
+    """
     tool = Path(command[0]).name
     found = entry_points(group="console_scripts", name=tool)
     if not found:
@@ -162,6 +183,12 @@ def _run_in_process(command: list[str], log: Path) -> int:
     main = next(iter(found)).load()
     saved = sys.argv
     sys.argv = [tool, *command[1:]]
+    threads = None
+    if "OMP_NUM_THREADS" in env:
+        import torch
+
+        threads = torch.get_num_threads()
+        torch.set_num_threads(int(env["OMP_NUM_THREADS"]))
     try:
         with open(log, "a") as sink, contextlib.redirect_stdout(sink):
             main()
@@ -173,6 +200,10 @@ def _run_in_process(command: list[str], log: Path) -> int:
         return 1
     finally:
         sys.argv = saved
+        if threads is not None:
+            import torch
+
+            torch.set_num_threads(threads)
 
 
 def _complete(root: Path) -> Path:
@@ -203,6 +234,12 @@ def check_resumed_config(cfg: TableConfig) -> None:
         if f.default is not MISSING or f.default_factory is not MISSING
     }
     recorded = {**defaults, **recorded}
+    # and keys added inside nested configs: their value in a table made now (train.threads: 2, the count
+    # every earlier table trained with, torch's default on the 2-core machine they ran on)
+    current = _as_recorded(TableConfig())
+    for key, value in recorded.items():
+        if isinstance(value, dict) and isinstance(current.get(key), dict):
+            recorded[key] = {**current[key], **value}
     changed = sorted(k for k in now if k not in RESUMABLE_CHANGES and recorded.get(k) != now[k])
     if recorded.get("train_seeds") and now["train_seeds"][0] != recorded["train_seeds"][0]:
         changed.append("train_seeds (the first seed trains the policy the data were made with)")
@@ -300,7 +337,7 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int) -> Path:
     done = final_checkpoint(out, cfg.steps) / "config.json"
     command = train_command(cfg, dataset, f"local/{dataset.name}", out)
     execute = None if done.exists() else run_command(cfg, dataset, f"local/{dataset.name}", out)
-    run.run(f"train_{variant}_seed{seed}", command, done, execute)
+    run.run(f"train_{variant}_seed{seed}", command, done, execute, env=train_env(cfg))
     return done.parent
 
 

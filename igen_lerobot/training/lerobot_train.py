@@ -60,6 +60,11 @@ def clear_interrupted_run(output_dir: Path) -> None:
         shutil.rmtree(output_dir)
 
 
+def train_env(cfg: TrainConfig) -> dict[str, str]:
+    """Environment variables ``lerobot-train`` runs with: the thread count, when the config fixes it."""
+    return {} if cfg.threads is None else {"OMP_NUM_THREADS": str(cfg.threads)}
+
+
 def train_command(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir: Path) -> list[str]:
     """The ``lerobot-train`` command line, as a user would type it."""
     return [
@@ -114,11 +119,13 @@ def lerobot_train(cfg: TrainConfig, dataset_root: Path, repo_id: str, output_dir
         logger.info("training already done: %s", done)
         return done
     command = run_command(cfg, dataset_root, repo_id, output_dir)
-    logger.info("training: %s", " ".join(command))
+    logger.info("training: %s", " ".join([*(f"{k}={v}" for k, v in train_env(cfg).items()), *command]))
     log = output_dir.with_name(output_dir.name + ".log")
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "a") as out:
-        result = subprocess.run(command, stdout=out, stderr=subprocess.STDOUT, env={**os.environ}, check=False)
+        result = subprocess.run(
+            command, stdout=out, stderr=subprocess.STDOUT, env={**os.environ, **train_env(cfg)}, check=False
+        )
     if result.returncode != 0:
         tail = log.read_text()[-2000:]
         raise TrainingFailedError(f"lerobot-train failed (exit {result.returncode}); log {log}:\n{tail}")
