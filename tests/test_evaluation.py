@@ -180,6 +180,27 @@ def test_trials_over_worker_processes_match_one_process(block_grasp_config, bloc
     assert again.per_trial_steps == other.per_trial_steps  # a second target in the same pool: its own seeds
 
 
+def test_the_workers_cpu_time_counts_as_this_processs_childrens():
+    """A table step's cost is its process's children's CPU time; workers forked from multiprocessing's
+    fork server are the server's children, so the pool must reap the server for their time to count."""
+    import resource
+
+    from igen_lerobot.core.env_config import task_config_class
+    from igen_lerobot.evaluation.parallel import TrialPool
+    from igen_lerobot.training.policy_source import PolicySourceConfig
+
+    def children_cpu() -> float:
+        usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return usage.ru_utime + usage.ru_stime
+
+    before = children_cpu()
+    with TrialPool(task_config_class("block_grasp")(), workers=2) as pool:
+        result = pool.evaluate(PolicySourceConfig(), "scripted", 6, seed=7, max_steps=200, progress=False)
+    spent = children_cpu() - before
+    # the workers' simulation alone is most of the wall time the trials took; their start-up adds more
+    assert spent > 0.5 * result.seconds > 0, (spent, result.seconds)
+
+
 def test_a_checkpoints_actions_are_the_same_at_one_torch_thread_as_at_two(bc_rnn_checkpoint, block_grasp_config):
     """Evaluation workers run torch at one thread; a sampling BC-RNN checkpoint must act bit for bit as it
     does at two (tolerance 0), or ``--workers`` would change a table's numbers."""

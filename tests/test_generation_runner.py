@@ -55,10 +55,20 @@ def assert_same_episodes(a, b):
 
 
 def test_two_workers_give_the_same_dataset_as_one(job, reference, tmp_path):
+    import resource
+
+    def children_cpu() -> float:
+        usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return usage.ru_utime + usage.ru_stime
+
     spool = EpisodeSpool(tmp_path / "attempts")
+    before = children_cpu()
     stats = run_generation(job, spool, N, workers=2)
     assert stats.kept >= N and stats.success_rate > 0.5
     assert_same_episodes(first_kept(spool), first_kept(reference))
+    # the workers' CPU time reaches this process once the run ends (a table step records it as its cost);
+    # at least the simulation they did, most of the run's wall time
+    assert children_cpu() - before > 0.5 * stats.seconds > 0
 
 
 def test_a_killed_worker_is_replaced_and_nothing_is_lost(job, reference, tmp_path):

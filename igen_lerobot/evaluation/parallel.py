@@ -19,8 +19,8 @@ from tqdm import tqdm
 from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.exceptions import ConfigError, IgenError
+from igen_lerobot.core.processes import limit_threads, reap_forkserver
 from igen_lerobot.core.seeding import episode_seed
-from igen_lerobot.core.threads import limit_threads
 from igen_lerobot.evaluation.trials import EvalResult, rollout, trials_result
 from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
 
@@ -70,6 +70,7 @@ class TrialPool:
 
     def close(self) -> None:
         self._executor.shutdown(wait=True, cancel_futures=True)
+        reap_forkserver()
 
     def evaluate(
         self, source: PolicySourceConfig, name: str, trials: int, seed: int, max_steps: int, progress: bool = True

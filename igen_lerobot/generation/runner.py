@@ -28,7 +28,7 @@ from multiprocessing.connection import Connection, wait
 from tqdm import tqdm
 
 from igen_lerobot.core.exceptions import ConfigError, IgenError
-from igen_lerobot.core.threads import limit_threads
+from igen_lerobot.core.processes import limit_threads, reap_forkserver
 from igen_lerobot.datasets.spool import EpisodeSpool
 from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.job import AttemptRunner, GenerationJob
@@ -223,6 +223,8 @@ class _LocalPool:
             worker.process.join(timeout=5)
             if worker.process.is_alive():
                 worker.process.terminate()
+                worker.process.join(timeout=5)
+        reap_forkserver()
 
 
 class _InlinePool:
