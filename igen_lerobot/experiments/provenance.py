@@ -57,7 +57,8 @@ def machine_identity() -> str:
 def code_version() -> dict:
     """``{"commit", "dirty", "version", "machine"}``: commit None when not run from a git checkout (a wheel).
 
-    ``dirty`` says tracked files differ from the commit, so the commit alone does not name the code;
+    ``dirty`` says tracked files outside ``docs/`` differ from the commit, so the commit alone does not
+    name the code;
     ``machine`` is :func:`machine_identity`.
     """
     try:
@@ -67,7 +68,9 @@ def code_version() -> dict:
     commit = _git("rev-parse", "HEAD") if (REPO_ROOT / ".git").exists() else None
     dirty = None
     if commit is not None:
-        status = _git("status", "--porcelain", "--untracked-files=no")
+        # docs/ is left out: a finished table writes its JSON and the results page there, and the
+        # next table of a chain starts before anyone commits them; they change nothing a step makes
+        status = _git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)docs")
         dirty = None if status is None else bool(status)
     return {"commit": commit, "dirty": dirty, "version": package, "machine": machine_identity()}
 
