@@ -33,7 +33,8 @@ def reap_forkserver() -> None:
     a new server.
     """
     server = multiprocessing.forkserver._forkserver
-    if server._forkserver_pid is None:
+    stop = getattr(server, "_stop", None)  # CPython's own (closes the server's pipe, then waits for it)
+    if stop is None or getattr(server, "_forkserver_pid", None) is None:
         return
     with contextlib.suppress(OSError, ChildProcessError):
-        server._stop()  # CPython's own way to stop the server (closes its pipe, then waits for it)
+        stop()
