@@ -340,3 +340,25 @@ def test_randomised_generation_reaches_the_generators_only_and_names_its_own_tab
         in table_report._randomize_line(result["config"])[0]
     )
     assert not table_report.is_main_table(result)
+
+
+def test_a_step_is_dirty_for_changed_code_not_for_a_tables_own_docs(tmp_path, monkeypatch):
+    """A chain's finished table writes docs/results before the next table starts: that must not mark
+    the next table's steps dirty, while any changed code must."""
+    from igen_lerobot.experiments import provenance
+
+    def git(*args):
+        subprocess.run(["git", "-C", str(tmp_path), *args], check=True, capture_output=True)
+
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "results.md").write_text("# Results\n")
+    (tmp_path / "code.py").write_text("x = 1\n")
+    git("init", "-q")
+    git("add", ".")
+    git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "init")
+    monkeypatch.setattr(provenance, "REPO_ROOT", tmp_path)
+    assert provenance.code_version()["dirty"] is False
+    (tmp_path / "docs" / "results.md").write_text("# Results\n\na new table\n")
+    assert provenance.code_version()["dirty"] is False
+    (tmp_path / "code.py").write_text("x = 2\n")
+    assert provenance.code_version()["dirty"] is True
