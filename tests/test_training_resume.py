@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 
 from igen_lerobot.training.config_train import TrainConfig
 from igen_lerobot.training.lerobot_train import final_checkpoint, is_finished, last_saved_step, lerobot_train
@@ -37,3 +38,30 @@ def test_a_run_without_a_checkpoint_starts_again(source_demos, tmp_path):
     cfg = TrainConfig(policy_type="bc_rnn", steps=2, batch_size=8, num_workers=0)
     done = lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
     assert _step(done) == 2 and is_finished(out, 2)
+
+
+def _weights(out, step):
+    return (out / "checkpoints" / f"{step:06d}" / "pretrained_model" / "model.safetensors").read_bytes()
+
+
+def test_a_resumed_run_ends_with_the_weights_of_an_uninterrupted_one(source_demos, tmp_path):
+    """Tables resume trainings across sessions, so a resume must not change what the table reports.
+
+    The interruption is made exactly: a finished 4-step run loses its step-4 checkpoint, as a run
+    killed between its two saves would, and is brought to step 4 again. Tolerance: none (bytes).
+    """
+    out = tmp_path / "bc_rnn"
+    cfg = TrainConfig(policy_type="bc_rnn", steps=4, batch_size=8, num_workers=0, save_freq=2, seed=3)
+    lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
+    uninterrupted = _weights(out, 4)
+    assert uninterrupted != _weights(out, 2)  # the last two steps changed the weights
+
+    shutil.rmtree(out / "checkpoints" / "000004")
+    (out / "checkpoints" / "last").unlink()
+    (out / "checkpoints" / "last").symlink_to("000002")
+    assert last_saved_step(out) == 2
+    lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
+
+    assert _weights(out, 4) == uninterrupted
+    # and it was a resume, not a second run from scratch (which would match as well)
+    assert (tmp_path / "bc_rnn.log").read_text().count("Resuming data order at epoch") == 1
