@@ -130,6 +130,17 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
         low, high = row["ci95"]
         assert 0 <= low <= row["success_rate"] <= high <= 1
 
+    # a rerun with every step done (a chain of tables resuming) leaves the table's record as it was:
+    # not re-stamped with the rerun's commit and its seconds of wall time
+    (tmp_path / "results" / "block_grasp.json").write_text(json.dumps({**resumed, "code": {"commit": "f" * 40}}))
+    third = subprocess.run(
+        [*cmd, "--train_seeds=[7,8]", "--variants=[base,igen]"], capture_output=True, text=True, timeout=180, env=ENV
+    )
+    assert third.returncode == 0, third.stderr[-4000:]
+    unchanged = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
+    assert unchanged["code"] == {"commit": "f" * 40}
+    assert unchanged == {**resumed, "code": {"commit": "f" * 40}}
+
 
 def test_shipped_results_are_what_igen_table_renders_from_their_json():
     """docs/results.md is the page igen-table renders from docs/results/*.json: no hand-edited numbers."""
@@ -362,3 +373,19 @@ def test_a_step_is_dirty_for_changed_code_not_for_a_tables_own_docs(tmp_path, mo
     assert provenance.code_version()["dirty"] is False
     (tmp_path / "code.py").write_text("x = 2\n")
     assert provenance.code_version()["dirty"] is True
+
+
+def test_a_run_that_ran_steps_records_itself_and_one_that_ran_none_keeps_the_record(tmp_path):
+    from igen_lerobot.experiments.provenance import keep_assembly_record
+
+    recorded = tmp_path / "t.json"
+    recorded.write_text(json.dumps({"code": {"commit": "a" * 40}, "wall_time_s": 6000.0}))
+    ran = {"code": {"commit": "b" * 40}, "wall_time_s": 300.0}
+    keep_assembly_record(ran, recorded, executed=["train_base_seed1000"])
+    assert ran == {"code": {"commit": "b" * 40}, "wall_time_s": 300.0}
+    idle = {"code": {"commit": "b" * 40}, "wall_time_s": 1.2}
+    keep_assembly_record(idle, recorded, executed=[])
+    assert idle == {"code": {"commit": "a" * 40}, "wall_time_s": 6000.0}
+    first = {"code": {"commit": "b" * 40}, "wall_time_s": 1.2}
+    keep_assembly_record(first, tmp_path / "none.json", executed=[])  # nothing recorded yet: its own record
+    assert first["code"] == {"commit": "b" * 40}

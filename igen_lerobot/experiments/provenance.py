@@ -10,6 +10,8 @@ what made it.
 
 from __future__ import annotations
 
+import json
+import logging
 import os
 import platform
 import subprocess
@@ -17,6 +19,7 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
+logger = logging.getLogger(__name__)
 
 
 def _git(*args: str) -> str | None:
@@ -105,6 +108,23 @@ def provenance_problems(result: dict) -> list[str]:
         missing = sorted(fields - set(config or {}))
         problems.append(f"config is not a whole {config_class.__name__} (missing {missing})")
     return problems
+
+
+def keep_assembly_record(result: dict, recorded: Path, executed: list[str]) -> None:
+    """Keep the commit and wall time of the run that made ``recorded`` when this one ran no step.
+
+    Rerunning a finished table (as a chain of tables does when it resumes) only reads its results
+    back; it must not stamp the table with today's commit and a wall time of seconds.
+    """
+    if executed or not recorded.exists():
+        return
+    try:
+        previous = json.loads(recorded.read_text())
+    except (OSError, json.JSONDecodeError):
+        return
+    if "code" in previous and "wall_time_s" in previous:
+        logger.info("%s: every step was done already; keeping the commit and wall time it records", recorded)
+        result["code"], result["wall_time_s"] = previous["code"], previous["wall_time_s"]
 
 
 def code_line(result: dict) -> str:

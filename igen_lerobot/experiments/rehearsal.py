@@ -31,6 +31,7 @@ from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import wilson_interval
 from igen_lerobot.experiments.config_rehearsal import PATHS, RehearsalConfig
+from igen_lerobot.experiments.provenance import keep_assembly_record
 from igen_lerobot.experiments.rehearsal_report import KIND, ordering
 from igen_lerobot.experiments.table import StepFailedError, StepRunner, chosen_checkpoint
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
@@ -270,6 +271,7 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
     }
     folder = results_folder(Path(cfg.results))
     folder.mkdir(parents=True, exist_ok=True)
+    keep_assembly_record(result, folder / f"{name}.json", runner.executed)
     (folder / f"{name}.json").write_text(json.dumps(result, indent=2))
     Path(cfg.results).write_text(render_results_page(folder))
     return result

@@ -37,7 +37,7 @@ from igen_lerobot.core.paper import safe_name
 from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
-from igen_lerobot.experiments.provenance import code_version
+from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import (
     BASE_STEPS,
@@ -80,6 +80,7 @@ class StepRunner:
         self.dry_run = dry_run
         self.bin = Path(sys.executable).parent
         self.commands: list[dict] = []
+        self.executed: list[str] = []  # the steps this invocation ran (not found done already)
         self.code = code_version()
         # step -> seconds and step -> code version, kept on disk so that a table resumed over
         # several sessions still knows how long every step took and which code made it
@@ -120,6 +121,7 @@ class StepRunner:
         log = self.out / "logs" / f"{name}.log"
         log.parent.mkdir(parents=True, exist_ok=True)
         command = execute or command
+        self.executed.append(name)
         logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
         start, cpu_start = time.perf_counter(), cpu_seconds()
         if self.in_process:
@@ -523,6 +525,7 @@ def run_table(cfg: TableConfig) -> dict:
     results = Path(cfg.results)
     folder = results_folder(results)
     folder.mkdir(parents=True, exist_ok=True)
+    keep_assembly_record(result, folder / f"{cfg.name}.json", run.executed)
     (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
     results.write_text(render_results_page(folder))
     return result
