@@ -285,6 +285,18 @@ def test_a_table_fixes_its_training_threads_and_a_bad_count_is_refused():
         TrainConfig(threads=0)
 
 
+def test_a_train_flag_on_the_command_line_keeps_the_tables_other_training_defaults():
+    """`igen-table --train.threads=1` must not silently drop the table's checkpoints every 500 steps."""
+    from igen_lerobot.scripts.cli import parse_config
+
+    default = parse_config(TableConfig, [])
+    assert (default.train.steps, default.train.save_freq, default.train.threads) == (2000, 500, 2)
+    one_thread = parse_config(TableConfig, ["--train.threads=1"])
+    assert (one_thread.train.steps, one_thread.train.save_freq, one_thread.train.threads) == (2000, 500, 1)
+    longer = parse_config(TableConfig, ["--train.steps=5000", "--train.save_freq=1000"])
+    assert (longer.train.save_freq, longer.train.threads) == (1000, 2)
+
+
 def test_the_main_table_across_tasks_has_a_column_per_task_with_all_seven_rows():
     """Tables of the main shape (all seven variants, full observability, not a named table) become one
     combined table, ours (paper) and the interval per cell; other tables stay out of it."""

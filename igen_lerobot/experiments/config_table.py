@@ -22,6 +22,18 @@ TABLE_TRAIN_THREADS = 2
 
 
 @dataclass
+class TableTrainConfig(TrainConfig):
+    """A table's training defaults, as class defaults: draccus builds ``--train.*`` from the class.
+
+    With the defaults in a ``default_factory`` instead, any ``--train.*`` flag (``--train.threads=1``)
+    silently reset the others to ``TrainConfig``'s: one checkpoint instead of four to choose from.
+    """
+
+    save_freq: int = 500
+    threads: int | None = TABLE_TRAIN_THREADS
+
+
+@dataclass
 class TableConfig:
     """Sizes follow the paper (10 source episodes, 1000 generated, 50 trials); shrink them for a smoke run.
 
@@ -51,7 +63,7 @@ class TableConfig:
     # generated row's data); sources are collected, and every policy evaluated, on the task's own arm.
     # Quote each flag: --randomize='["--env.randomize.kp_scale=[0.5,1.5]","--env.randomize.latency=[0,0.04]"]'
     randomize: list[str] = field(default_factory=list)
-    train: TrainConfig = field(default_factory=lambda: TrainConfig(steps=2000, save_freq=500))
+    train: TableTrainConfig = field(default_factory=TableTrainConfig)
     train_seeds: list[int] | None = None  # default: train.seed and the two after it; given, its first is train.seed
     eval_every: int = 1  # validate every k-th saved checkpoint (the last always), test the best
     n_val_trials: int = 50
