@@ -9,6 +9,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from dataclasses import asdict
 from pathlib import Path
 
@@ -401,3 +402,35 @@ def test_a_run_that_ran_steps_records_itself_and_one_that_ran_none_keeps_the_rec
     first = {"code": {"commit": "b" * 40}, "wall_time_s": 1.2}
     keep_assembly_record(first, tmp_path / "none.json", executed=[])  # nothing recorded yet: its own record
     assert first["code"] == {"commit": "b" * 40}
+
+
+def test_a_step_stopped_by_sigterm_records_its_leg_and_resumes(tmp_path):
+    """A session's end (SIGTERM) must not erase what the stopped leg cost: the table's time says it."""
+    import signal
+    import threading
+
+    from igen_lerobot.experiments.provenance import provenance_lines
+    from igen_lerobot.experiments.table import StepRunner
+
+    runner = StepRunner(tmp_path)
+    done = tmp_path / "done"
+    stop = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGTERM))
+    stop.start()
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        runner.run("train_x", ["sleep", "30"], done)
+    assert time.perf_counter() - started < 10  # the child was stopped with it, not waited for
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # the handler is the step's only
+    stopped = json.loads((tmp_path / "step_interrupted_times.json").read_text())
+    assert 0.9 <= stopped["train_x"] <= 10.0 and "train_x" not in runner.timings  # tolerance: the timer's start
+
+    resumed = StepRunner(tmp_path)  # the next session
+    resumed.run("train_x", ["touch", str(done)], done)
+    assert resumed.interrupted == stopped and resumed.timings["train_x"] < 5.0
+    result = {
+        "wall_time_s": 60.0,
+        "step_times_s": resumed.timings,
+        "step_interrupted_s": resumed.interrupted,
+        "commands": resumed.commands,
+    }
+    assert "plus 0.0 min in the legs of 1 step stopped between sessions" in "\n".join(provenance_lines(result))

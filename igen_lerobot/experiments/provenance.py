@@ -171,13 +171,25 @@ def cpu_line(result: dict) -> str:
     )
 
 
+def interrupted_part(result: dict) -> str:
+    """The wall time of steps' legs stopped between sessions, which the steps' own times leave out."""
+    stopped = result.get("step_interrupted_s") or {}
+    if not stopped:
+        return ""
+    return (
+        f", plus {sum(stopped.values()) / 60:.1f} min in the legs of {len(stopped)} "
+        f"step{'' if len(stopped) == 1 else 's'} stopped between sessions (a training resumes from its last "
+        "checkpoint, so part of that was redone)"
+    )
+
+
 def provenance_lines(result: dict) -> list[str]:
     """How a recorded run was made: its code versions and machines, its wall time and every command."""
     return [
         code_line(result),
         machine_line(result),
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
-        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min.",
+        f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min{interrupted_part(result)}.",
         cpu_line(result),
         "",
         "Commands:",

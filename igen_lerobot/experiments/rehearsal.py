@@ -268,6 +268,7 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
         "wall_time_s": time.perf_counter() - start,
         "step_times_s": {step: t for step, t in runner.timings.items() if step in ran},
         "step_cpu_s": {step: t for step, t in runner.cpu_times.items() if step in ran},
+        "step_interrupted_s": {step: t for step, t in runner.interrupted.items() if step in ran},
     }
     folder = results_folder(Path(cfg.results))
     folder.mkdir(parents=True, exist_ok=True)

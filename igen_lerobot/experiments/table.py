@@ -25,8 +25,10 @@ import logging
 import os
 import resource
 import shlex
+import signal
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import MISSING, asdict, fields, is_dataclass, replace
 from importlib.metadata import entry_points
@@ -92,6 +94,11 @@ class StepRunner:
         self.cpu_times: dict[str, float] = _read_json(self.cpu_times_file, {})
         self.versions_file = self.out / "step_commits.json"
         self.versions: dict[str, dict] = _read_json(self.versions_file, {})
+        # step -> wall seconds of its legs that were stopped (a session's end): a resumed step's record
+        # above holds only its finishing leg, so without these a table stopped between sessions would
+        # look cheaper than it was
+        self.interrupted_file = self.out / "step_interrupted_times.json"
+        self.interrupted: dict[str, float] = _read_json(self.interrupted_file, {})
 
     def data(self, name: str) -> Path:
         return self.out / "data" / name
@@ -124,13 +131,21 @@ class StepRunner:
         self.executed.append(name)
         logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
         start, cpu_start = time.perf_counter(), cpu_seconds()
-        if self.in_process:
-            code = _run_in_process(command, log, env)
-        else:
-            with open(log, "a") as sink:
-                code = subprocess.run(
-                    command, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
-                ).returncode
+        try:
+            with _termination_as_interrupt():
+                if self.in_process:
+                    code = _run_in_process(command, log, env)
+                else:
+                    with open(log, "a") as sink:
+                        code = subprocess.run(
+                            command, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
+                        ).returncode
+        except KeyboardInterrupt:
+            self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
+            self.out.mkdir(parents=True, exist_ok=True)
+            self.interrupted_file.write_text(json.dumps(self.interrupted, indent=2))
+            logger.info("%s: stopped; rerun to resume it", name)
+            raise
         if code == 0 and done.exists():
             # a resumed step adds this leg to what earlier legs recorded
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
@@ -166,6 +181,23 @@ def cpu_seconds() -> float:
     """User + system CPU seconds of this process and of its children that have ended."""
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def _raise_interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+@contextlib.contextmanager
+def _termination_as_interrupt():
+    """SIGTERM (``kill``, the end of a session) ends a step as Ctrl-C does, so its leg is recorded."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _read_json(path: Path, default):
@@ -521,6 +553,7 @@ def run_table(cfg: TableConfig) -> dict:
         "wall_time_s": time.perf_counter() - start,
         "step_times_s": {step: t for step, t in run.timings.items() if step in ran},
         "step_cpu_s": {step: t for step, t in run.cpu_times.items() if step in ran},
+        "step_interrupted_s": {step: t for step, t in run.interrupted.items() if step in ran},
     }
     results = Path(cfg.results)
     folder = results_folder(results)
