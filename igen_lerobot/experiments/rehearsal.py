@@ -31,7 +31,6 @@ from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import wilson_interval
 from igen_lerobot.experiments.config_rehearsal import PATHS, RehearsalConfig
-from igen_lerobot.experiments.provenance import keep_assembly_record
 from igen_lerobot.experiments.rehearsal_report import KIND, ordering
 from igen_lerobot.experiments.table import StepFailedError, StepRunner, chosen_checkpoint
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
@@ -237,9 +236,10 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
                 "results": results,
             }
         )
-    ran = {step["step"] for step in runner.commands}
     randomize = table.get("randomize") or []  # a table generated on randomised arms is rehearsed under its own name
     name = f"{TASK}_randomized_rehearsal" if randomize else f"{TASK}_rehearsal"
+    folder = results_folder(Path(cfg.results))
+    folder.mkdir(parents=True, exist_ok=True)
     result = {
         "kind": KIND,
         "task": TASK,
@@ -262,17 +262,8 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
         "rows": result_rows,
         "results": [{"variant": r["variant"], "path": p, **r["results"][p]} for r in result_rows for p in cfg.paths],
         "ordering": {p: ordering(result_rows, p) for p in cfg.paths},
-        "code": runner.code,
-        "step_code": {step: runner.versions.get(step) for step in sorted(ran)},
-        "commands": runner.commands,
-        "wall_time_s": time.perf_counter() - start,
-        "step_times_s": {step: t for step, t in runner.timings.items() if step in ran},
-        "step_cpu_s": {step: t for step, t in runner.cpu_times.items() if step in ran},
-        "step_interrupted_s": {step: t for step, t in runner.interrupted.items() if step in ran},
+        **runner.record(start, folder / f"{name}.json"),
     }
-    folder = results_folder(Path(cfg.results))
-    folder.mkdir(parents=True, exist_ok=True)
-    keep_assembly_record(result, folder / f"{name}.json", runner.executed)
     (folder / f"{name}.json").write_text(json.dumps(result, indent=2))
     Path(cfg.results).write_text(render_results_page(folder))
     return result

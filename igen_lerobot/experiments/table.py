@@ -159,6 +159,25 @@ class StepRunner:
             tail = log.read_text()[-1500:]
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
 
+    def record(self, started: float, recorded: Path) -> dict:
+        """What made the result about to be written to ``recorded``: commits, commands, times.
+
+        ``started``: ``time.perf_counter()`` when this run began. A run that executed no step keeps
+        the commit and wall time ``recorded`` already holds (``keep_assembly_record``).
+        """
+        ran = {step["step"] for step in self.commands}
+        record = {
+            "code": self.code,
+            "step_code": {step: self.versions.get(step) for step in sorted(ran)},
+            "commands": self.commands,
+            "wall_time_s": time.perf_counter() - started,
+            "step_times_s": {step: t for step, t in self.timings.items() if step in ran},
+            "step_cpu_s": {step: t for step, t in self.cpu_times.items() if step in ran},
+            "step_interrupted_s": {step: t for step, t in self.interrupted.items() if step in ran},
+        }
+        keep_assembly_record(record, recorded, self.executed)
+        return record
+
     def igen(self, tool: str, *args: str) -> list[str]:
         return [str(self.bin / tool), *args]
 
@@ -539,26 +558,18 @@ def run_table(cfg: TableConfig) -> dict:
         )
         if not trains_with_base(variant, run.derived):
             rows[-1]["without_base"] = True  # trained on its own data alone, not D plus it
-    ran = {step["step"] for step in run.commands}
+    results = Path(cfg.results)
+    folder = results_folder(results)
+    folder.mkdir(parents=True, exist_ok=True)
     result = {
         "task": cfg.task,
         "name": cfg.name,
         "reveal": env.reveal.value,
         **({"columns": run.columns, "choose_on": run.choose_on} if run.columns else {}),
         "config": asdict(cfg),
-        "code": run.code,
-        "step_code": {step: run.versions.get(step) for step in sorted(ran)},
         "rows": rows,
-        "commands": run.commands,
-        "wall_time_s": time.perf_counter() - start,
-        "step_times_s": {step: t for step, t in run.timings.items() if step in ran},
-        "step_cpu_s": {step: t for step, t in run.cpu_times.items() if step in ran},
-        "step_interrupted_s": {step: t for step, t in run.interrupted.items() if step in ran},
+        **run.record(start, folder / f"{cfg.name}.json"),
     }
-    results = Path(cfg.results)
-    folder = results_folder(results)
-    folder.mkdir(parents=True, exist_ok=True)
-    keep_assembly_record(result, folder / f"{cfg.name}.json", run.executed)
     (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
     results.write_text(render_results_page(folder))
     return result
