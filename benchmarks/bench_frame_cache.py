@@ -4,11 +4,12 @@ r"""What the frame cache buys BC-RNN training: LeRobot's reader against ``Cached
         --samples 300 --train_steps 200
 
 On one dataset: (1) seconds per ``LeRobotDataset[i]`` with BC-RNN's window (``horizon`` frames of
-every observation and the action) on the same random indices, both readers, and whether every
-sample is identical; (2) ``lerobot-train --policy.type=bc_rnn`` for ``--train_steps`` steps at the
-table's settings (batch 100, 2 loader workers) with ``IGEN_FRAME_CACHE=1`` and ``=0``: mean
-steps/s of its training loop (tqdm's elapsed time, loader start-up included), wall time, and
-whether the saved weights are bit-identical.
+every observation and the action) on the same random indices with LeRobot's reader, the cache
+holding only the windows, and the whole cache, and whether every sample is identical;
+(2) ``lerobot-train --policy.type=bc_rnn`` for ``--train_steps`` steps at the table's settings
+(batch 100, 2 loader workers) with ``IGEN_FRAME_CACHE=1`` and ``=0``: mean steps/s of its training
+loop (tqdm's elapsed time, loader start-up included), wall time, and whether the saved weights are
+bit-identical.
 Run it on an idle machine; prints one JSON object.
 """
 
@@ -28,14 +29,20 @@ import numpy as np
 import torch
 
 
-def sample_seconds(root: Path, samples: int, cached: bool) -> tuple[float, list[dict]]:
+def sample_seconds(root: Path, samples: int, reader: str) -> tuple[float, list[dict]]:
+    """Seconds per sample with ``reader``: "lerobot", "windows" (only windows held) or "cached"."""
     from lerobot.datasets import lerobot_dataset
     from lerobot.datasets.dataset_reader import DatasetReader
 
     from igen_lerobot.training import frame_cache
     from igen_lerobot.training.bc_rnn import BCRNNConfig
 
-    lerobot_dataset.DatasetReader = frame_cache.CachedFrameReader if cached else DatasetReader
+    class WindowsOnlyReader(frame_cache.CachedFrameReader):
+        def _rows_for(self, hf_dataset):
+            return None  # each sample's row and episode bounds from LeRobot's lookups
+
+    readers = {"lerobot": DatasetReader, "windows": WindowsOnlyReader, "cached": frame_cache.CachedFrameReader}
+    lerobot_dataset.DatasetReader = readers[reader]
     meta = lerobot_dataset.LeRobotDataset("local/bench", root=root).meta
     horizon = BCRNNConfig().horizon
     keys = [k for k in meta.features if k.startswith("observation.") or k == "action"]
@@ -86,13 +93,16 @@ def main() -> None:
     parser.add_argument("--train_steps", type=int, default=200)
     args = parser.parse_args()
 
-    plain_s, plain_items = sample_seconds(args.root, args.samples, cached=False)
-    cached_s, cached_items = sample_seconds(args.root, args.samples, cached=True)
+    plain_s, plain_items = sample_seconds(args.root, args.samples, "lerobot")
+    windows_s, windows_items = sample_seconds(args.root, args.samples, "windows")
+    cached_s, cached_items = sample_seconds(args.root, args.samples, "cached")
     report = {
         "root": str(args.root),
-        "sample_ms": {"lerobot": round(plain_s * 1e3, 2), "cached": round(cached_s * 1e3, 2)},
+        "sample_ms": {
+            k: round(v * 1e3, 3) for k, v in (("lerobot", plain_s), ("windows_only", windows_s), ("cached", cached_s))
+        },
         "sample_speedup": round(plain_s / cached_s, 1),
-        "samples_identical": same_items(plain_items, cached_items),
+        "samples_identical": same_items(plain_items, cached_items) and same_items(plain_items, windows_items),
     }
     if args.train_steps > 0:
         from safetensors.torch import load_file

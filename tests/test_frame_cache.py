@@ -1,5 +1,6 @@
-"""The frame cache gives LeRobot's own samples: every key, dtype and padding flag, and the same
-trained weights through ``lerobot-train`` (spawned loader workers included)."""
+"""The frame cache gives LeRobot's own samples: every key (in LeRobot's order), dtype and padding
+flag, whether the whole sample or only its windows come from memory, and the same trained weights through
+``lerobot-train`` (spawned loader workers included)."""
 
 from __future__ import annotations
 
@@ -43,11 +44,12 @@ def test_cached_windows_equal_lerobots_for_every_key(source_demos, upstream_read
     cached = _windows(source_demos, episodes, cached=True)
     assert isinstance(cached.reader, frame_cache.CachedFrameReader)
     assert not isinstance(upstream.reader, frame_cache.CachedFrameReader)
+    assert cached.reader._rows_for(cached.reader.hf_dataset) is not None  # whole samples from memory
     n = len(upstream)
     picks = sorted({0, 1, n - 1, *np.random.default_rng(0).integers(0, n, 40).tolist()})
     for i in picks:
         a, b = upstream[i], cached[i]
-        assert a.keys() == b.keys()
+        assert list(a) == list(b), i  # the same keys in the same order
         for key, value in a.items():
             if isinstance(value, torch.Tensor):
                 assert value.dtype == b[key].dtype and value.shape == b[key].shape, (i, key)
@@ -65,6 +67,7 @@ def test_columns_too_large_to_hold_stay_on_lerobots_path(source_demos, upstream_
         a, b = upstream[i], cached[i]
         assert all(torch.equal(a[k], b[k]) for k in a if isinstance(a[k], torch.Tensor))
     assert cached.reader._columns_for(cached.reader.hf_dataset) == {}
+    assert cached.reader._rows_for(cached.reader.hf_dataset) is None  # the row comes from LeRobot's lookup too
 
 
 def test_switched_off_by_environment(monkeypatch, upstream_reader):

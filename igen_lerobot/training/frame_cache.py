@@ -8,7 +8,12 @@ the data loader, not the model, bounds training: about 6 ms a sample, 0.5 s a st
 tensor per process and slices it: the same tensors (dtype, shape, values; tests/test_frame_cache.py
 compares every key against LeRobot's own reader), about 25 times faster a sample.
 
-It is LeRobot's ``DatasetReader`` with one method overridden, installed by importing the BC-RNN
+Whole samples come from memory too when every column of the dataset is numeric and no frame is a
+video: the current row and the episode bounds (LeRobot indexes an Arrow table for each, which was
+most of a loader worker's time once the windows were cached). Any other dataset keeps LeRobot's
+row lookup and only its windows are cached.
+
+It is LeRobot's ``DatasetReader`` with three methods overridden, installed by importing the BC-RNN
 plugin (so every ``lerobot-train`` in an environment that has this project uses it); set
 ``IGEN_FRAME_CACHE=0`` to train with LeRobot's reader unchanged.
 """
@@ -39,8 +44,61 @@ class CachedFrameReader(DatasetReader):
 
     def __getstate__(self) -> dict:
         state = self.__dict__.copy()
-        state.pop("_frame_columns", None)  # rebuilt by each loader worker, not shipped to it
+        for held in ("_frame_columns", "_row_columns", "_bounds"):
+            state.pop(held, None)  # rebuilt by each loader worker, not shipped to it
         return state
+
+    def get_item(self, idx) -> dict:
+        """LeRobot's sample (``DatasetReader.get_item``) read from held columns, when all are numeric."""
+        rows = self._rows_for(self.hf_dataset)
+        if rows is None:
+            return super().get_item(idx)
+        item = {key: column[idx] for key, column in rows.items()}
+        if self.delta_indices is not None:
+            query_indices, padding = self._get_query_indices(int(item["index"]), int(item["episode_index"]))
+            item = {**item, **padding, **self._query_hf_dataset(query_indices)}
+        item["task"] = self._meta.tasks.iloc[int(item["task_index"])].name
+        return item
+
+    def _get_query_indices(self, abs_idx: int, ep_idx: int) -> tuple[dict[str, list[int]], dict[str, torch.Tensor]]:
+        """LeRobot's window indices and padding flags, with the episode's bounds read from memory."""
+        starts, ends = self._episode_bounds()
+        ep_start, ep_end = int(starts[ep_idx]), int(ends[ep_idx])
+        query_indices = {
+            key: [max(ep_start, min(ep_end - 1, abs_idx + delta)) for delta in deltas]
+            for key, deltas in self.delta_indices.items()
+        }
+        padding = {
+            f"{key}_is_pad": torch.BoolTensor([not ep_start <= abs_idx + delta < ep_end for delta in deltas])
+            for key, deltas in self.delta_indices.items()
+        }
+        return query_indices, padding
+
+    def _episode_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every episode's first and one-past-last frame index, by episode index."""
+        held = getattr(self, "_bounds", None)
+        if held is None:
+            columns = ["episode_index", "dataset_from_index", "dataset_to_index"]
+            episodes = self._meta.episodes.with_format("numpy", columns=columns)[:]
+            size = int(episodes["episode_index"].max()) + 1
+            starts, ends = np.full(size, -1, np.int64), np.full(size, -1, np.int64)
+            starts[episodes["episode_index"]] = episodes["dataset_from_index"]
+            ends[episodes["episode_index"]] = episodes["dataset_to_index"]
+            held = self._bounds = (starts, ends)
+        return held
+
+    def _rows_for(self, hf_dataset) -> dict[str, torch.Tensor] | None:
+        """Every column of ``hf_dataset`` held in memory, or None where a sample needs LeRobot's path."""
+        held = getattr(self, "_row_columns", None)
+        token = (id(hf_dataset), len(hf_dataset))
+        if held is None or held[0] != token:
+            names = hf_dataset.column_names
+            columns = None
+            if not self._meta.video_keys and all(self._cacheable(key) for key in names):
+                windows = self._columns_for(hf_dataset)
+                columns = {key: windows[key] if key in windows else _column_as_torch(hf_dataset, key) for key in names}
+            held = self._row_columns = (token, columns)
+        return held[1]
 
     def _query_hf_dataset(self, query_indices: dict[str, list[int]]) -> dict:
         columns = self._columns_for(self.hf_dataset)
