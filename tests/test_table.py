@@ -434,3 +434,15 @@ def test_a_step_stopped_by_sigterm_records_its_leg_and_resumes(tmp_path):
         "commands": resumed.commands,
     }
     assert "plus 0.0 min in the legs of 1 step stopped between sessions" in "\n".join(provenance_lines(result))
+
+
+def test_each_step_records_the_code_checked_out_when_it_started(tmp_path, monkeypatch):
+    """A commit landed while a table runs is named by the steps started after it, not the earlier ones."""
+    from igen_lerobot.experiments import table
+
+    checkouts = iter([{"commit": "a" * 40, "dirty": False}, {"commit": "b" * 40, "dirty": False}])
+    monkeypatch.setattr(table, "code_version", lambda: next(checkouts))
+    runner = table.StepRunner(tmp_path)  # the table's start: commit a
+    runner.run("first", ["touch", str(tmp_path / "first")], tmp_path / "first")  # started at commit b
+    assert runner.code["commit"] == "a" * 40
+    assert json.loads((tmp_path / "step_commits.json").read_text())["first"]["commit"] == "b" * 40

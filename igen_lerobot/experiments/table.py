@@ -130,6 +130,9 @@ class StepRunner:
         command = execute or command
         self.executed.append(name)
         logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
+        # the code checked out when this step starts, which is what its subprocess imports: a commit
+        # landed while a long table runs shows in the steps started after it, not in the earlier ones
+        step_code = code_version()
         start, cpu_start = time.perf_counter(), cpu_seconds()
         try:
             with _termination_as_interrupt():
@@ -150,7 +153,7 @@ class StepRunner:
             # a resumed step adds this leg to what earlier legs recorded
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
             self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
-            self.versions[name] = self.code
+            self.versions[name] = step_code
             self.out.mkdir(parents=True, exist_ok=True)
             self.timings_file.write_text(json.dumps(self.timings, indent=2))
             self.cpu_times_file.write_text(json.dumps(self.cpu_times, indent=2))
