@@ -9,13 +9,15 @@ import dataclasses
 
 import numpy as np
 import pytest
+from in_hand_checks import (
+    assert_placed_over_the_region_without_recompiling,
+    assert_the_operator_recovers,
+    blind_insertion,
+)
 
-from igen_lerobot.collection.record import record_intervention
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import NoNoise, RadialNoise
 from igen_lerobot.core.geometry import make_pose
-from igen_lerobot.core.seeding import episode_seed
-from igen_lerobot.core.task import FrameSource
 
 
 @pytest.fixture(scope="module")
@@ -48,14 +50,7 @@ def test_the_pod_starts_in_the_hand_above_the_machine_region(env):
         np.testing.assert_allclose(np.linalg.norm(pod[:2, 3] - env.eef_pose()[:2, 3]), 0.0, atol=0.001)
         np.testing.assert_allclose(machine[:3, :3], np.eye(3), atol=1e-12)
         np.testing.assert_allclose(machine[2, 3], TABLE_TOP_Z, atol=1e-12)
-    centres = np.array(centres)
-    assert np.all(np.abs(centres) <= 0.05 + 1e-9)  # the 10 x 10 cm region ...
-    assert np.ptp(centres[:, 0]) > 0.07 and np.ptp(centres[:, 1]) > 0.07  # ... and it is used
-    model = env.model  # the fixed machine is moved at reset without recompiling
-    env.reset(1)
-    first = env.data.xpos[env.bodies["machine"]].copy()
-    env.reset(2)
-    assert env.model is model and not np.allclose(first, env.data.xpos[env.bodies["machine"]])
+    assert_placed_over_the_region_without_recompiling(env, "machine", np.array(centres))
 
 
 def test_the_machine_error_is_the_papers_radial_2_to_4_cm(env):
@@ -96,16 +91,7 @@ def test_every_machine_geom_reveals_the_body_and_the_holder_alike(config):
 
 def _blind_insertion(config, offset_xy):
     """The scripted policy believing the machine ``offset_xy`` [m] off, never told better."""
-    cfg = dataclasses.replace(config, corruption=RadialNoise(r_min=0.0, r_max=0.05), reveal=Reveal.NONE)
-    env, policy = cfg.make_task_env(), cfg.make_scripted_policy()
-    obs = env.reset(0, corruption=np.array([*offset_xy, 0.0]))  # it aims offset_xy beside the true holder
-    success = False
-    for _ in range(cfg.episode_length):
-        success = env.step(policy.act(obs)).success
-        obs = env.observe()
-        if success:
-            break
-    return env, success
+    return blind_insertion(config, RadialNoise(r_min=0.0, r_max=0.05), (*offset_xy, 0.0))
 
 
 def test_the_pod_goes_in_up_to_4_mm_off_and_jams_on_the_rim_beyond(config):
@@ -182,13 +168,4 @@ def test_the_scripted_operator_recovers_from_the_papers_error(config):
     over at that contact, lifts the pod, moves it over the true holder and puts it in."""
     from lerobot_env_igen.coffee.spec import POD_HALF_HEIGHT, RING_TOP_Z
 
-    env, policy, operator = config.make_task_env(), config.make_scripted_policy(), config.make_scripted_operator()
-    spec = config.task_spec
-    for i in range(6):
-        ep = record_intervention(env, policy, operator, episode_seed(1, i), config.episode_length)
-        assert ep.success and ep.is_intervention.any()
-        takeover = int(np.flatnonzero(ep.is_intervention)[0])
-        assert ep.source[takeover] == FrameSource.OPERATOR and ep.env_state[takeover, spec.env_state_index("revealed")]
-        pod_z = ep.true_object_pose[takeover:, spec.objects.index("pod") * 7 + 2]
-        assert pod_z.max() - POD_HALF_HEIGHT > RING_TOP_Z + 0.015  # lifted clear of the rim before going in again
-    env.close()
+    assert_the_operator_recovers(config, "pod", RING_TOP_Z + POD_HALF_HEIGHT + 0.015, 6)

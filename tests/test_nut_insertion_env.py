@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from in_hand_checks import assert_placed_over_the_region_without_recompiling
 
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import NoNoise
@@ -44,15 +45,7 @@ def test_the_nut_starts_in_the_hand_above_the_peg_region(nut_env):
         # the nut's square is aligned with the peg (up to a quarter turn): yaw = 0 mod 90 degrees
         yaw = np.arctan2(poses["nut"][1, 0], poses["nut"][0, 0])
         assert min(abs(yaw % (np.pi / 2)), np.pi / 2 - abs(yaw % (np.pi / 2))) < np.deg2rad(2)
-    pegs = np.array(pegs)
-    assert np.all(np.abs(pegs) <= 0.05 + 1e-9)  # the 10 x 10 cm region ...
-    assert np.ptp(pegs[:, 0]) > 0.07 and np.ptp(pegs[:, 1]) > 0.07  # ... and it is used
-    # the fixed peg is moved at reset without recompiling: one model, its body really moves
-    model = nut_env.model
-    nut_env.reset(1)
-    first = nut_env.data.xpos[nut_env.bodies["peg"]].copy()
-    nut_env.reset(2)
-    assert nut_env.model is model and not np.allclose(first, nut_env.data.xpos[nut_env.bodies["peg"]])
+    assert_placed_over_the_region_without_recompiling(nut_env, "peg", np.array(pegs))
 
 
 def test_the_peg_error_is_the_papers(nut_env):

@@ -9,13 +9,16 @@ import dataclasses
 
 import numpy as np
 import pytest
+from in_hand_checks import (
+    assert_placed_over_the_region_without_recompiling,
+    assert_the_operator_recovers,
+    blind_insertion,
+)
 
-from igen_lerobot.collection.record import record_intervention
 from igen_lerobot.core.belief import Reveal
 from igen_lerobot.core.error_models import BoxNoise, NoNoise
 from igen_lerobot.core.geometry import make_pose
-from igen_lerobot.core.seeding import episode_seed
-from igen_lerobot.core.task import OBS_ENV_STATE, FrameSource
+from igen_lerobot.core.task import OBS_ENV_STATE
 
 
 @pytest.fixture(scope="module")
@@ -47,14 +50,7 @@ def test_the_piece_starts_in_the_hand_above_the_receptacle_region(env):
         np.testing.assert_allclose(piece[:3, :3], receptacle[:3, :3], atol=0.02)  # yaw aligned, level
         np.testing.assert_allclose(receptacle[:3, :3], np.eye(3), atol=1e-12)
         np.testing.assert_allclose(receptacle[2, 3], TABLE_TOP_Z + RECEPTACLE_SIZE[2] / 2, atol=1e-12)
-    centres = np.array(centres)
-    assert np.all(np.abs(centres) <= 0.05 + 1e-9)  # the 10 x 10 cm region ...
-    assert np.ptp(centres[:, 0]) > 0.07 and np.ptp(centres[:, 1]) > 0.07  # ... and it is used
-    model = env.model  # the fixed receptacle is moved at reset without recompiling
-    env.reset(1)
-    first = env.data.xpos[env.bodies["receptacle"]].copy()
-    env.reset(2)
-    assert env.model is model and not np.allclose(first, env.data.xpos[env.bodies["receptacle"]])
+    assert_placed_over_the_region_without_recompiling(env, "receptacle", np.array(centres))
 
 
 def test_the_receptacle_error_is_the_papers(env):
@@ -66,16 +62,7 @@ def test_the_receptacle_error_is_the_papers(env):
 
 def _blind_insertion(config, offset_x: float):
     """The scripted policy believing the receptacle ``offset_x`` [m] off along x, never told better."""
-    cfg = dataclasses.replace(config, corruption=BoxNoise(min_abs=(0.0, 0.0, 0.0)), reveal=Reveal.NONE)
-    env, policy = cfg.make_task_env(), cfg.make_scripted_policy()
-    obs = env.reset(0, corruption=np.array([-offset_x, 0.0, 0.0]))  # it aims offset_x beside the true centre
-    success = False
-    for _ in range(cfg.episode_length):
-        success = env.step(policy.act(obs)).success
-        obs = env.observe()
-        if success:
-            break
-    return env, success
+    return blind_insertion(config, BoxNoise(min_abs=(0.0, 0.0, 0.0)), (-offset_x, 0.0, 0.0))
 
 
 def test_the_piece_goes_in_up_to_6_mm_off_and_jams_on_the_rim_beyond(config):
@@ -133,18 +120,8 @@ def test_the_scripted_operator_recovers_from_the_papers_error(config, reveal):
     over at that contact, lifts the piece, moves it over the true receptacle and puts it in."""
     from lerobot_env_igen.two_piece_assembly.spec import RECEPTACLE_SIZE, SLAB_HALF, TABLE_TOP_Z
 
-    cfg = dataclasses.replace(config, reveal=reveal)
-    env, policy, operator = cfg.make_task_env(), cfg.make_scripted_policy(), cfg.make_scripted_operator()
-    spec = cfg.task_spec
     rim = TABLE_TOP_Z + RECEPTACLE_SIZE[2]
-    for i in range(8):
-        ep = record_intervention(env, policy, operator, episode_seed(1, i), cfg.episode_length)
-        assert ep.success and ep.is_intervention.any()
-        takeover = int(np.flatnonzero(ep.is_intervention)[0])
-        assert ep.source[takeover] == FrameSource.OPERATOR and ep.env_state[takeover, spec.env_state_index("revealed")]
-        piece_z = ep.true_object_pose[takeover:, spec.objects.index("piece") * 7 + 2]
-        assert piece_z.max() - SLAB_HALF[2] > rim + 0.015  # lifted clear of the rim before going in again
-    env.close()
+    assert_the_operator_recovers(dataclasses.replace(config, reveal=reveal), "piece", rim + SLAB_HALF[2] + 0.015, 8)
 
 
 def test_direction_reveal_gives_the_unit_vector_to_the_true_receptacle(config):
