@@ -176,6 +176,12 @@ def test_provenance_check_names_what_is_missing():
     partial = {**good, "config": {"task": "block_grasp"}, "code": {}}
     problems = provenance_problems(partial)
     assert problems[0].startswith("no commit") and "train_seeds" in problems[1]
+    # a field that only says where records go may be absent (tables published before it existed);
+    # one the config does not have is named
+    before_ledgers = {k: v for k, v in good["config"].items() if k != "ledger_dir"}
+    assert provenance_problems({**good, "config": before_ledgers}) == []
+    unknown = provenance_problems({**good, "config": {**good["config"], "speed": 2}})
+    assert unknown == ["config is not a whole TableConfig (unknown ['speed'])"]
 
 
 def test_every_step_records_the_machine_it_ran_on_and_the_page_says_when_they_differ():

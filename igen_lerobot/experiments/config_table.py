@@ -15,6 +15,10 @@ VAL_SEED = EVAL_SEED  # the trials earlier tables reported on: they choose check
 TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 
 
+# config fields that only say where a table keeps its records, added after tables were published:
+# a published config without them is still whole (they change no number)
+RECORD_ONLY_FIELDS = ("ledger_dir",)
+
 # torch threads of every table's trainings unless --train.threads says otherwise: fixed, so that a machine
 # with more cores trains the same weights; 2, what every earlier table trained with (torch's default on
 # the 2-core machine of docs/results.md)
@@ -71,6 +75,10 @@ class TableConfig:
     n_trials: int = 50  # test trials per training seed
     test_seed: int = TEST_SEED
     output_dir: str = "outputs/table"
+    # a folder kept in version control (docs/results/ledger/<table>) where each finished step's evaluation
+    # report, time and commit are copied as it finishes; a run on a new machine restores them and trains
+    # no seed whose evaluation is on record ("": keep none). Datasets and checkpoints are not kept.
+    ledger_dir: str = ""
     # the markdown page of every table; each table's JSON (and an optional <name>.notes.md with a reading
     # of it) lives in the folder of the same name (docs/results/), and the page is rendered from all of them
     results: str = "docs/results.md"

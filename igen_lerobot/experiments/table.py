@@ -23,6 +23,7 @@ import contextlib
 import json
 import logging
 import os
+import re
 import resource
 import shlex
 import signal
@@ -39,6 +40,7 @@ from igen_lerobot.core.paper import safe_name
 from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
+from igen_lerobot.experiments.ledger import Ledger
 from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import (
@@ -62,7 +64,16 @@ from igen_lerobot.training.lerobot_train import (
 logger = logging.getLogger(__name__)
 
 # config fields a resumed table may change: they do not change what a finished step made
-RESUMABLE_CHANGES = ("variants", "train_seeds", "workers", "in_process", "results", "output_dir", "dry_run")
+RESUMABLE_CHANGES = (
+    "variants",
+    "train_seeds",
+    "workers",
+    "in_process",
+    "results",
+    "output_dir",
+    "dry_run",
+    "ledger_dir",
+)
 
 
 class StepFailedError(IgenError, RuntimeError):
@@ -73,11 +84,15 @@ class StepRunner:
     """Runs and records the commands of a resumable run in ``out``; skips those whose output is already complete.
 
     ``in_process``: call each console script's entry point in this process (same arguments, recorded
-    the same) instead of a subprocess. ``dry_run``: record the commands, run none.
+    the same) instead of a subprocess. ``dry_run``: record the commands, run none. ``ledger``: where
+    each finished step's small records are copied as it finishes (:class:`Ledger`).
     """
 
-    def __init__(self, out: Path, in_process: bool = False, dry_run: bool = False) -> None:
+    def __init__(
+        self, out: Path, in_process: bool = False, dry_run: bool = False, ledger: Ledger | None = None
+    ) -> None:
         self.out = Path(out)
+        self.ledger = ledger or Ledger(None, self.out)
         self.in_process = in_process
         self.dry_run = dry_run
         self.bin = Path(sys.executable).parent
@@ -147,6 +162,7 @@ class StepRunner:
             self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
             self.out.mkdir(parents=True, exist_ok=True)
             self.interrupted_file.write_text(json.dumps(self.interrupted, indent=2))
+            self.ledger.keep_step_records()
             logger.info("%s: stopped; rerun to resume it", name)
             raise
         if code == 0 and done.exists():
@@ -158,6 +174,8 @@ class StepRunner:
             self.timings_file.write_text(json.dumps(self.timings, indent=2))
             self.cpu_times_file.write_text(json.dumps(self.cpu_times, indent=2))
             self.versions_file.write_text(json.dumps(self.versions, indent=2))
+            self.ledger.keep(done)
+            self.ledger.keep_step_records()
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
@@ -189,7 +207,10 @@ class TableRun(StepRunner):
     """The steps of one ``igen-table`` run, in its ``--output_dir``."""
 
     def __init__(self, cfg: TableConfig) -> None:
-        super().__init__(Path(cfg.output_dir), cfg.in_process, cfg.dry_run)
+        out = Path(cfg.output_dir)
+        super().__init__(
+            out, cfg.in_process, cfg.dry_run, Ledger(Path(cfg.ledger_dir) if cfg.ledger_dir else None, out)
+        )
         self.cfg = cfg
         paper = cfg.paper_table()
         self.derived = paper.derived if paper is not None else {}  # the table's own rows
@@ -197,6 +218,8 @@ class TableRun(StepRunner):
         # column whose validation trials choose the checkpoints
         self.columns = dict(paper.columns) if paper is not None else {}
         self.choose_on = paper.choose_on if paper is not None else ""
+        if not cfg.dry_run:
+            self.ledger.keep(self.out / "table_config.json")
 
 
 def cpu_seconds() -> float:
@@ -327,7 +350,7 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
     cfg = run.cfg
     for step in BASE_STEPS:
         build_step(run, step, policy="")
-    base_policy = str(train(run, "base", run.data("base"), cfg.train_seeds[0]))
+    base_policy = str(train(run, "base", run.data("base"), cfg.train_seeds[0], weights_needed=True))
     for step in needed_parts(cfg.variants, derived=run.derived):
         build_step(run, step, base_policy)
 
@@ -386,15 +409,57 @@ def chosen_checkpoint(table_dir: Path, variant: str, seed: int) -> tuple[int, Pa
     return step, step_checkpoint(table_dir / "train" / variant / f"seed{seed}", steps, step)
 
 
-def train(run: TableRun, variant: str, dataset: Path, seed: int) -> Path:
-    """``lerobot-train`` on a variant's dataset with one seed (same config for all); returns the last checkpoint."""
+def test_reports(out: Path, columns: dict, variant: str, seed: int, step: int) -> dict[str, Path]:
+    """Column -> where the checkpoint chosen at ``step`` was tested (``eval/<variant>/seed<k>/test*_step<n>.json``)."""
+    folder = Path(out) / "eval" / variant / f"seed{seed}"
+    suffixes = {column: f"_{safe_name(column)}" if column else "" for column in columns or {"": ()}}
+    return {column: folder / f"test{suffix}_step{step}.json" for column, suffix in suffixes.items()}
+
+
+def evaluation_on_record(out: Path, columns: dict, variant: str, seed: int) -> bool:
+    """Whether a training run was validated and its chosen checkpoint tested in every column: its numbers stand."""
+    report = validation_report(out, variant, seed)
+    if not report.exists():
+        return False
+    step = chosen_result(json.loads(report.read_text())).step
+    return all(path.exists() for path in test_reports(out, columns, variant, seed, step).values())
+
+
+def step_on_record(cfg: TableConfig, columns: dict, step: str) -> bool:
+    """Whether a step's output is on record in ``output_dir`` without being made again on this machine.
+
+    A run's evaluation steps are, once its validation report is; its training is, once its whole
+    evaluation is, except the first seed's base policy, which generation needs as weights. Datasets
+    never are (the ledger does not hold them).
+    """
+    parsed = re.fullmatch(r"(train|validate|test)_(.+?)_seed(\d+)(_.+)?", step)
+    if parsed is None:
+        return False
+    kind, variant, seed = parsed.group(1), parsed.group(2), int(parsed.group(3))
+    out = Path(cfg.output_dir)
+    if kind != "train":
+        return validation_report(out, variant, seed).exists()
+    needed_for_data = variant == "base" and seed == (cfg.train_seeds or [cfg.train.seed])[0]
+    return not needed_for_data and evaluation_on_record(out, columns, variant, seed)
+
+
+def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed: bool = False) -> Path:
+    """``lerobot-train`` on a variant's dataset with one seed (same config for all); returns the last checkpoint.
+
+    A run whose evaluation is on record (restored from the table's ledger on a new machine) is not
+    trained again unless ``weights_needed`` (the base policy that generation runs).
+    """
     cfg = replace(run.cfg.train, seed=seed, extra_args=list(run.cfg.train.extra_args))
     out = train_dir(run, variant, seed)
-    done = final_checkpoint(out, cfg.steps) / "config.json"
+    final = final_checkpoint(out, cfg.steps)
+    done = final / "config.json"
     command = train_command(cfg, dataset, f"local/{dataset.name}", out)
     execute = None if done.exists() else run_command(cfg, dataset, f"local/{dataset.name}", out)
+    may_skip = not (weights_needed or run.dry_run or done.exists())
+    if may_skip and evaluation_on_record(run.out, run.columns, variant, seed):
+        done = validation_report(run.out, variant, seed)  # its numbers stand: no checkpoint is read again
     run.run(f"train_{variant}_seed{seed}", command, done, execute, env=train_env(cfg))
-    return done.parent
+    return final
 
 
 def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: int, seed: int) -> dict:
@@ -426,7 +491,6 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     trials, all from ``--test_seed`` (the same scenes in each column: only the column's flags differ).
     """
     cfg = run.cfg
-    folder = run.out / "eval" / variant / f"seed{seed}"
     trained = train_dir(run, variant, seed)
     validation = _eval(
         run,
@@ -441,12 +505,13 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     step = cfg.train.steps if chosen is None else chosen.step
     checkpoint = step_checkpoint(trained, cfg.train.steps, step)
     tests = {}
+    reports = test_reports(run.out, run.columns, variant, seed, step)
     for column, flags in (run.columns or {"": ()}).items():
         suffix = f"_{safe_name(column)}" if column else ""
         tests[column] = _eval(
             run,
             f"test_{variant}_seed{seed}{suffix}",
-            folder / f"test{suffix}_step{step}.json",
+            reports[column],
             [*flags, f"--policy.path={checkpoint}"],
             cfg.n_trials,
             cfg.test_seed,
@@ -537,6 +602,10 @@ def plan(cfg: TableConfig) -> list[dict]:
 
 def run_table(cfg: TableConfig) -> dict:
     """Build, train and evaluate every variant; write the table's JSON and re-render the results page."""
+    if cfg.ledger_dir:
+        paper = cfg.paper_table()
+        columns = dict(paper.columns) if paper is not None else {}
+        Ledger(Path(cfg.ledger_dir), Path(cfg.output_dir)).restore(lambda step: step_on_record(cfg, columns, step))
     check_resumed_config(cfg)
     run = TableRun(cfg)
     start = time.perf_counter()

@@ -1,0 +1,94 @@
+"""A long run's small records kept outside its output folder, where a lost machine cannot take them.
+
+A paper table runs for hours across sessions; its output folder (datasets, checkpoints) is tens of
+GB and lives on one machine. What its published numbers rest on is small: the evaluation reports
+and each step's time and commit. The ledger copies those, as each step finishes, into a folder that
+is kept in version control (``docs/results/ledger/<table>``), and a run on a new machine restores
+them first: every training seed whose evaluation is on record is not trained again, and only what
+the records do not hold (datasets, the policy the data are generated with) is made again.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+logger = logging.getLogger(__name__)
+
+# step -> value records (times, commits) a run keeps beside its outputs
+STEP_RECORDS = ("step_times.json", "step_cpu_times.json", "step_commits.json", "step_interrupted_times.json")
+# the run's own settings, and the folder of its evaluation reports: what else the ledger keeps
+KEPT_FILES = ("table_config.json",)
+KEPT_FOLDERS = ("eval",)
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    """A reader (or a machine lost mid-write) sees the old file or the new one, never half of one."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f".{path.name}.partial")
+    partial.write_text(text)
+    os.replace(partial, path)
+
+
+class Ledger:
+    """Copies a run's small records from ``out`` into ``folder`` and back (``folder`` None: keeps nothing)."""
+
+    def __init__(self, folder: Path | None, out: Path) -> None:
+        self.folder = Path(folder) if folder else None
+        self.out = Path(out)
+
+    def is_kept(self, path: Path) -> bool:
+        """Whether ``path`` (inside ``out``) is a record the ledger keeps."""
+        try:
+            relative = Path(path).relative_to(self.out)
+        except ValueError:
+            return False
+        if relative.as_posix() in (*KEPT_FILES, *STEP_RECORDS):
+            return True
+        return relative.suffix == ".json" and relative.parts[0] in KEPT_FOLDERS
+
+    def keep(self, *paths: Path) -> None:
+        """Copy each kept file of ``paths`` that exists into the ledger (others are ignored)."""
+        if self.folder is None:
+            return
+        for path in paths:
+            if path.exists() and self.is_kept(path):
+                _write_atomically(self.folder / path.relative_to(self.out), path.read_text())
+
+    def keep_step_records(self) -> None:
+        self.keep(*(self.out / name for name in STEP_RECORDS))
+
+    def restore(self, on_record: Callable[[str], bool]) -> list[Path]:
+        """Copy into ``out`` every kept file it lacks; returns what was copied.
+
+        Step records are merged per step, ``out``'s own entries first; the ledger's entry of a step
+        is taken only when ``on_record(step)``: a step whose output the ledger does not hold (a
+        dataset, a checkpoint needed again) is made again here, and its record is this making's.
+        """
+        if self.folder is None or not self.folder.is_dir():
+            return []
+        restored = []
+        kept = sorted(p for p in self.folder.rglob("*") if p.is_file() and not p.name.startswith("."))
+        records = [p for p in kept if p.relative_to(self.folder).as_posix() in STEP_RECORDS]
+        # the reports first: ``on_record`` reads them to tell which steps the ledger holds
+        for path in (p for p in kept if p not in records):
+            local = self.out / path.relative_to(self.folder)
+            if not local.exists():
+                local.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(path, local)
+                restored.append(local)
+        for path in records:
+            local = self.out / path.relative_to(self.folder)
+            own = json.loads(local.read_text()) if local.exists() else {}
+            theirs = {step: v for step, v in json.loads(path.read_text()).items() if on_record(step)}
+            merged = {**theirs, **own}
+            if merged != own:
+                _write_atomically(local, json.dumps(merged, indent=2))
+                restored.append(local)
+        if restored:
+            logger.info("restored %d records from the ledger %s", len(restored), self.folder)
+        return restored

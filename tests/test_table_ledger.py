@@ -1,0 +1,104 @@
+"""A table survives the loss of its machine: the ledger keeps each finished step's small records,
+and a run on an empty output folder restores them and trains only what generation needs again."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from igen_lerobot.experiments.ledger import STEP_RECORDS, Ledger
+
+ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
+
+
+def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data_policy(tmp_path):
+    out, ledger, results = tmp_path / "table", tmp_path / "ledger", tmp_path / "results.md"
+    cmd = [
+        str(Path(sys.executable).parent / "igen-table"),
+        "--variants=[base]",
+        "--train_seeds=[7,8]",
+        "--source_episodes=2",
+        "--base_demos=4",
+        "--train.steps=2",
+        "--train.save_freq=1",
+        "--train.batch_size=8",
+        "--train.num_workers=0",
+        "--n_trials=1",
+        "--n_val_trials=1",
+        "--workers=1",
+        "--in_process=true",
+        f"--output_dir={out}",
+        f"--results={results}",
+        f"--ledger_dir={ledger}",
+    ]
+    first = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=ENV)
+    assert first.returncode == 0, first.stderr[-4000:]
+    report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
+
+    # the ledger holds the evaluation reports, the step records and the config: no dataset, no checkpoint
+    kept = {p.relative_to(ledger).as_posix() for p in ledger.rglob("*") if p.is_file()}
+    assert {"table_config.json", *STEP_RECORDS[:3]} <= kept
+    for seed in (7, 8):
+        assert f"eval/base/seed{seed}/validation.json" in kept
+        step = next(s["chosen_step"] for s in report["rows"][0]["seeds"] if s["seed"] == seed)
+        assert f"eval/base/seed{seed}/test_step{step}.json" in kept
+    assert not any(k.startswith(("data/", "train/", "logs/")) for k in kept), kept
+    recorded = json.loads((ledger / "step_times.json").read_text())
+    assert recorded == json.loads((out / "step_times.json").read_text())
+
+    # the machine is lost: only the ledger is left
+    shutil.rmtree(out)
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=ENV)
+    assert again.returncode == 0, again.stderr[-4000:]
+    resumed = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
+    # seed 8's numbers are read back from the ledger; it is neither trained nor evaluated again
+    assert not (out / "train" / "base" / "seed8").exists()
+    assert not any((out / "logs").glob("*seed8*"))
+    # seed 7's base policy is trained again (generation runs it), its evaluation read back
+    assert (out / "train" / "base" / "seed7").is_dir()
+    assert (out / "logs" / "train_base_seed7.log").exists()
+    assert not (out / "logs" / "validate_base_seed7.log").exists()
+    assert resumed["rows"][0]["seeds"] == report["rows"][0]["seeds"]
+    times = json.loads((out / "step_times.json").read_text())
+    # the evaluation steps and seed 8's training keep the times that made them; the steps made again
+    # (datasets, seed 7's base policy) record this making's, not the lost one's plus it
+    for step in ("validate_base_seed7", "test_base_seed7", "train_base_seed8", "validate_base_seed8"):
+        assert times[step] == recorded[step], step
+    for step in ("source_demos", "base", "train_base_seed7"):
+        assert times[step] != recorded[step], step
+    assert json.loads((ledger / "step_times.json").read_text()) == times
+
+
+def test_the_ledger_keeps_only_small_records_and_never_overwrites_a_local_one(tmp_path):
+    out, folder = tmp_path / "out", tmp_path / "ledger"
+    ledger = Ledger(folder, out)
+    report = out / "eval" / "igen" / "seed1" / "validation.json"
+    report.parent.mkdir(parents=True)
+    report.write_text('{"results": []}')
+    dataset_marker = out / "data" / "igen" / "meta" / "igen.json"
+    dataset_marker.parent.mkdir(parents=True)
+    dataset_marker.write_text("{}")
+    checkpoint = out / "train" / "igen" / "seed1" / "config.json"
+    checkpoint.parent.mkdir(parents=True)
+    checkpoint.write_text("{}")
+    (out / "step_times.json").write_text(json.dumps({"igen": 5.0, "validate_igen_seed1": 2.0}))
+    ledger.keep(report, dataset_marker, checkpoint, tmp_path / "elsewhere.json")
+    ledger.keep_step_records()
+    assert sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()) == [
+        "eval/igen/seed1/validation.json",
+        "step_times.json",
+    ]
+    assert not list(folder.rglob(".*.partial"))  # written whole, then renamed
+
+    # a new machine that already made one step again: its own record wins, and only steps on record return
+    shutil.rmtree(out)
+    (out / "eval" / "igen" / "seed1").mkdir(parents=True)
+    (out / "eval" / "igen" / "seed1" / "validation.json").write_text('{"local": true}')
+    (out / "step_times.json").write_text(json.dumps({"validate_igen_seed1": 9.0}))
+    restored = ledger.restore(on_record=lambda step: step != "igen")
+    assert json.loads((out / "step_times.json").read_text()) == {"validate_igen_seed1": 9.0}
+    assert json.loads((out / "eval" / "igen" / "seed1" / "validation.json").read_text()) == {"local": True}
+    assert restored == []
+    assert Ledger(None, out).restore(on_record=lambda step: True) == []
