@@ -22,6 +22,12 @@
 # the randomised I-Gen row passed 47/60 rehearsal trials through franky, at 6000 55/60
 # (docs/benchmarks.md, "A longer training budget").
 #
+# A machine can be lost between sessions with its outputs: every table keeps its evaluation reports,
+# step times and commits in docs/results/ledger/<name> (version-controlled) as each step finishes, and
+# on a new machine restores them and trains no seed whose numbers are on record; only datasets and
+# the policy they are generated with are made again. A table already published in
+# docs/results/<name>.json is not made again unless REDO names it (REDO=all: every table).
+#
 # Every row of a table trains the same way: its budget (the in-hand tasks and Nut-and-Peg train 5000
 # steps, Block Grasp the paper's 2000, Block Grasp on randomised arms 6000), its thread count (Block
 # Grasp 2, made before the lanes; every later table 1) plus PROTOCOL, the settings every table shares.
@@ -80,8 +86,13 @@ for name in "${names[@]}"; do
       || { echo "$(date +%T) $name: its table $table is not finished; skipped (rerun when it is)"; continue; }
     ! other_lane_alive || { echo "$(date +%T) $name: runs alone, and another lane is running; skipped"; continue; }
   else
+    if [ -e "docs/results/$name.json" ] && [ ! -e "$root/$name/table_config.json" ] \
+      && [[ " ${REDO:-} " != *" $name "* && "${REDO:-}" != all ]]; then
+      echo "$(date +%T) $name: published in docs/results/$name.json; REDO=$name makes it again"; continue
+    fi
     read -r -a flags <<< "${TABLES[$name]}"
-    command=("$bin/igen-table" "${flags[@]}" "${PROTOCOL[@]}" --output_dir="$root/$name" --dry_run="${DRY_RUN:-false}")
+    command=("$bin/igen-table" "${flags[@]}" "${PROTOCOL[@]}" --output_dir="$root/$name"
+      --ledger_dir="docs/results/ledger/$name" --dry_run="${DRY_RUN:-false}")
   fi
   if [ "${DRY_RUN:-false}" = true ]; then echo "$(date +%T) $name: ${command[*]}"; "${command[@]}"; continue; fi
   status=0
