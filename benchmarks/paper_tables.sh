@@ -26,7 +26,9 @@
 # step times and commits in docs/results/ledger/<name> (version-controlled) as each step finishes, and
 # on a new machine restores them and trains no seed whose numbers are on record; only datasets and
 # the policy they are generated with are made again. A table already published in
-# docs/results/<name>.json is not made again unless REDO names it (REDO=all: every table).
+# docs/results/<name>.json is not made again unless REDO names it (REDO=all: every table). The
+# rehearsal reads its table's checkpoints, so that table trains again the runs it restores
+# (--retrain_restored=true: deterministic, the weights that were tested).
 #
 # Every row of a table trains the same way: its budget (the in-hand tasks and Nut-and-Peg train 5000
 # steps, Block Grasp the paper's 2000, Block Grasp on randomised arms 6000), its thread count (Block
@@ -51,7 +53,7 @@ declare -A TABLES=(
   [coffee]="--task=coffee ${long[*]}"
   [two_piece_assembly_scaling]="--task=two_piece_assembly --table=scaling ${long[*]}"
   [nut_and_peg]="--task=nut_and_peg ${long[*]}"
-  [block_grasp_randomized]="--task=block_grasp --randomize=${RANDOMIZE} --variants=${SIM_TO_REAL_ROWS} --train.steps=6000 --train.save_freq=1000 --train.threads=1"
+  [block_grasp_randomized]="--task=block_grasp --randomize=${RANDOMIZE} --variants=${SIM_TO_REAL_ROWS} --train.steps=6000 --train.save_freq=1000 --train.threads=1 --retrain_restored=true"
 )
 ORDER=(block_grasp nut_insertion nut_insertion_contact_position block_grasp_randomized
   block_grasp_randomized_rehearsal two_piece_assembly coffee two_piece_assembly_direction

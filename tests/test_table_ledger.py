@@ -8,7 +8,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.experiments.ledger import STEP_RECORDS, Ledger
+from igen_lerobot.experiments.table import chosen_checkpoint
 
 ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
 
@@ -69,6 +73,16 @@ def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data
     for step in ("source_demos", "base", "train_base_seed7"):
         assert times[step] != recorded[step], step
     assert json.loads((ledger / "step_times.json").read_text()) == times
+
+    # a rehearsal reads the chosen checkpoints: missing, they are named with the flag that makes them again
+    with pytest.raises(ConfigError, match="--retrain_restored=true"):
+        chosen_checkpoint(out, "base", 8)
+    third = subprocess.run([*cmd, "--retrain_restored=true"], capture_output=True, text=True, timeout=300, env=ENV)
+    assert third.returncode == 0, third.stderr[-4000:]
+    step, checkpoint = chosen_checkpoint(out, "base", 8)
+    assert (checkpoint / "config.json").exists()
+    assert (out / "logs" / "train_base_seed8.log").exists() and not (out / "logs" / "validate_base_seed8.log").exists()
+    assert json.loads((tmp_path / "results" / "block_grasp.json").read_text())["rows"] == resumed["rows"]
 
 
 def test_the_ledger_keeps_only_small_records_and_never_overwrites_a_local_one(tmp_path):

@@ -15,9 +15,9 @@ VAL_SEED = EVAL_SEED  # the trials earlier tables reported on: they choose check
 TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 
 
-# config fields that only say where a table keeps its records, added after tables were published:
-# a published config without them is still whole (they change no number)
-RECORD_ONLY_FIELDS = ("ledger_dir",)
+# config fields added after tables were published that change no number (where records are kept,
+# whether weights are made again): a published config without them is still whole
+NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored")
 
 # torch threads of every table's trainings unless --train.threads says otherwise: fixed, so that a machine
 # with more cores trains the same weights; 2, what every earlier table trained with (torch's default on
@@ -79,6 +79,9 @@ class TableConfig:
     # report, time and commit are copied as it finishes; a run on a new machine restores them and trains
     # no seed whose evaluation is on record ("": keep none). Datasets and checkpoints are not kept.
     ledger_dir: str = ""
+    # train again the runs whose numbers were restored from the ledger, so that their checkpoints are on
+    # this machine (igen-rehearse reads them); training is deterministic, so the weights are those tested
+    retrain_restored: bool = False
     # the markdown page of every table; each table's JSON (and an optional <name>.notes.md with a reading
     # of it) lives in the folder of the same name (docs/results/), and the page is rendered from all of them
     results: str = "docs/results.md"

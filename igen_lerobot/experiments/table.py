@@ -73,6 +73,7 @@ RESUMABLE_CHANGES = (
     "output_dir",
     "dry_run",
     "ledger_dir",
+    "retrain_restored",
 )
 
 
@@ -406,7 +407,14 @@ def chosen_checkpoint(table_dir: Path, variant: str, seed: int) -> tuple[int, Pa
         )
     steps = json.loads((table_dir / "table_config.json").read_text())["train"]["steps"]
     step = chosen_result(json.loads(report.read_text())).step
-    return step, step_checkpoint(table_dir / "train" / variant / f"seed{seed}", steps, step)
+    checkpoint = step_checkpoint(table_dir / "train" / variant / f"seed{seed}", steps, step)
+    if not (checkpoint / "config.json").exists():
+        raise ConfigError(
+            f"{table_dir}: the checkpoint {variant} seed {seed} was tested with ({checkpoint}) is not on this "
+            "machine (its numbers were restored from the table's ledger); rerun its igen-table command with "
+            "--retrain_restored=true to train it again (deterministic: the same weights)"
+        )
+    return step, checkpoint
 
 
 def test_reports(out: Path, columns: dict, variant: str, seed: int, step: int) -> dict[str, Path]:
@@ -447,7 +455,8 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     """``lerobot-train`` on a variant's dataset with one seed (same config for all); returns the last checkpoint.
 
     A run whose evaluation is on record (restored from the table's ledger on a new machine) is not
-    trained again unless ``weights_needed`` (the base policy that generation runs).
+    trained again unless ``weights_needed`` (the base policy that generation runs) or the table is
+    asked to (``--retrain_restored``).
     """
     cfg = replace(run.cfg.train, seed=seed, extra_args=list(run.cfg.train.extra_args))
     out = train_dir(run, variant, seed)
@@ -455,7 +464,7 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     done = final / "config.json"
     command = train_command(cfg, dataset, f"local/{dataset.name}", out)
     execute = None if done.exists() else run_command(cfg, dataset, f"local/{dataset.name}", out)
-    may_skip = not (weights_needed or run.dry_run or done.exists())
+    may_skip = not (weights_needed or run.cfg.retrain_restored or run.dry_run or done.exists())
     if may_skip and evaluation_on_record(run.out, run.columns, variant, seed):
         done = validation_report(run.out, variant, seed)  # its numbers stand: no checkpoint is read again
     run.run(f"train_{variant}_seed{seed}", command, done, execute, env=train_env(cfg))
