@@ -65,3 +65,52 @@ def test_a_resumed_run_ends_with_the_weights_of_an_uninterrupted_one(source_demo
     assert _weights(out, 4) == uninterrupted
     # and it was a resume, not a second run from scratch (which would match as well)
     assert (tmp_path / "bc_rnn.log").read_text().count("Resuming data order at epoch") == 1
+
+
+def test_a_run_resumed_after_its_first_epoch_ends_with_the_weights_of_an_uninterrupted_one(source_demos, tmp_path):
+    """LeRobot 0.6 with accelerate restarts the data order at epoch 0 on resume (resume_order mends it).
+
+    Batches of 100 make an epoch a few steps long; the run resumes one step into its second epoch
+    and ends in its third. Tolerance: none (bytes).
+    """
+    info = json.loads((source_demos / "meta" / "info.json").read_text())
+    per_epoch = -(-info["total_frames"] // 100)
+    resume_at = per_epoch + 1
+    out = tmp_path / "bc_rnn"
+    cfg = TrainConfig(policy_type="bc_rnn", steps=2 * resume_at, batch_size=100, num_workers=0, save_freq=resume_at)
+    lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
+    uninterrupted = _weights(out, cfg.steps)
+
+    shutil.rmtree(out / "checkpoints" / f"{cfg.steps:06d}")
+    (out / "checkpoints" / "last").unlink()
+    (out / "checkpoints" / "last").symlink_to(f"{resume_at:06d}")
+    lerobot_train(cfg, source_demos, "local/block_grasp_demos", out)
+
+    assert "Resuming data order at epoch 1, sample 100" in (tmp_path / "bc_rnn.log").read_text()
+    assert _weights(out, cfg.steps) == uninterrupted
+
+
+def test_a_restored_sampler_counts_the_loaders_passes_from_the_epoch_it_was_stopped_in():
+    """accelerate calls ``set_epoch(k)`` before its k-th pass, k from 0 in every process."""
+    from lerobot.datasets.sampler import EpisodeAwareSampler
+
+    from igen_lerobot.training import resume_order
+
+    assert resume_order.install()
+
+    def sampler() -> EpisodeAwareSampler:
+        return EpisodeAwareSampler([0, 7], [7, 20], shuffle=True, seed=5)
+
+    uninterrupted = sampler()
+    passes = []
+    for k in range(4):
+        uninterrupted.set_epoch(k)
+        passes.append(list(uninterrupted))
+    assert passes[2] != passes[0]
+
+    resumed = sampler()
+    resumed.load_state_dict({"epoch": 2, "start_index": 4})
+    resumed.set_epoch(0)
+    assert list(resumed) == passes[2][4:]
+    resumed.set_epoch(1)
+    assert list(resumed) == passes[3]
