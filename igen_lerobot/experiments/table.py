@@ -417,11 +417,15 @@ def chosen_checkpoint(table_dir: Path, variant: str, seed: int) -> tuple[int, Pa
     return step, checkpoint
 
 
-def test_reports(out: Path, columns: dict, variant: str, seed: int, step: int) -> dict[str, Path]:
+def _column_suffix(column: str) -> str:
+    """How a test step and its report name their column ("" for a table without columns)."""
+    return f"_{safe_name(column)}" if column else ""
+
+
+def tested_reports(out: Path, columns: dict, variant: str, seed: int, step: int) -> dict[str, Path]:
     """Column -> where the checkpoint chosen at ``step`` was tested (``eval/<variant>/seed<k>/test*_step<n>.json``)."""
     folder = Path(out) / "eval" / variant / f"seed{seed}"
-    suffixes = {column: f"_{safe_name(column)}" if column else "" for column in columns or {"": ()}}
-    return {column: folder / f"test{suffix}_step{step}.json" for column, suffix in suffixes.items()}
+    return {column: folder / f"test{_column_suffix(column)}_step{step}.json" for column in columns or {"": ()}}
 
 
 def evaluation_on_record(out: Path, columns: dict, variant: str, seed: int) -> bool:
@@ -430,7 +434,7 @@ def evaluation_on_record(out: Path, columns: dict, variant: str, seed: int) -> b
     if not report.exists():
         return False
     step = chosen_result(json.loads(report.read_text())).step
-    return all(path.exists() for path in test_reports(out, columns, variant, seed, step).values())
+    return all(path.exists() for path in tested_reports(out, columns, variant, seed, step).values())
 
 
 def step_on_record(cfg: TableConfig, columns: dict, step: str) -> bool:
@@ -514,12 +518,11 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     step = cfg.train.steps if chosen is None else chosen.step
     checkpoint = step_checkpoint(trained, cfg.train.steps, step)
     tests = {}
-    reports = test_reports(run.out, run.columns, variant, seed, step)
+    reports = tested_reports(run.out, run.columns, variant, seed, step)
     for column, flags in (run.columns or {"": ()}).items():
-        suffix = f"_{safe_name(column)}" if column else ""
         tests[column] = _eval(
             run,
-            f"test_{variant}_seed{seed}{suffix}",
+            f"test_{variant}_seed{seed}{_column_suffix(column)}",
             reports[column],
             [*flags, f"--policy.path={checkpoint}"],
             cfg.n_trials,
