@@ -66,9 +66,26 @@ def test_two_workers_give_the_same_dataset_as_one(job, reference, tmp_path):
     stats = run_generation(job, spool, N, workers=2)
     assert stats.kept >= N and stats.success_rate > 0.5
     assert_same_episodes(first_kept(spool), first_kept(reference))
+    # the recorded counts too: only those up to the dataset's last kept attempt, whatever ran past it
+    ours, theirs = spool.outcome(N), reference.outcome(N)
+    assert (ours.attempted, ours.kept, ours.dropped) == (theirs.attempted, theirs.kept, theirs.dropped)
+    assert ours.attempted == spool.kept_attempts()[N - 1] + 1
     # the workers' CPU time reaches this process once the run ends (a table step records it as its cost);
     # at least the simulation they did, most of the run's wall time
     assert children_cpu() - before > 0.5 * stats.seconds > 0
+
+
+def test_the_outcome_counts_only_attempts_up_to_the_last_kept_one(reference, tmp_path):
+    spool = EpisodeSpool(tmp_path / "attempts")
+    episode = reference.load(reference.kept_attempts()[0])
+    for attempt in (0, 2, 5, 7):
+        spool.keep(attempt, episode)
+    for attempt, reason in ((1, "failed"), (3, "failed"), (4, "no_mistake"), (6, "failed"), (8, "failed")):
+        spool.reject(attempt, reason)
+    outcome = spool.outcome(3)  # the dataset is attempts 0, 2 and 5
+    assert (outcome.attempted, outcome.kept, outcome.run_past_the_last) == (6, 3, 3)
+    assert outcome.dropped == {"failed": 2, "no_mistake": 1}
+    assert outcome.success_rate == pytest.approx(0.5)
 
 
 def test_a_killed_worker_is_replaced_and_nothing_is_lost(job, reference, tmp_path):

@@ -11,12 +11,31 @@ from __future__ import annotations
 import json
 import re
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 from igen_lerobot.core.episode import Episode
 
 _KEPT = re.compile(r"^attempt_(\d{8})\.npz$")
 _REJECTED = re.compile(r"^attempt_(\d{8})\.rejected\.json$")
+
+
+@dataclass(frozen=True)
+class GenerationOutcome:
+    """What it took to keep the dataset's episodes, counted over the attempts up to its last one.
+
+    Workers run a few attempts past the last one a dataset needs (they were in flight when it
+    finished); how many depends on scheduling, so they are counted apart and never in the rate.
+    """
+
+    attempted: int  # kept or dropped attempts up to the dataset's last kept one (one that raised is not spooled)
+    kept: int
+    dropped: dict[str, int]
+    run_past_the_last: int  # attempts finished beyond it (scheduling-dependent)
+
+    @property
+    def success_rate(self) -> float:
+        return self.kept / self.attempted if self.attempted else 0.0
 
 
 class EpisodeSpool:
@@ -58,6 +77,19 @@ class EpisodeSpool:
             reason = json.loads(self._rejected_path(attempt).read_text())["reason"]
             counts[reason] = counts.get(reason, 0) + 1
         return counts
+
+    def outcome(self, num_episodes: int) -> GenerationOutcome:
+        """Counts behind the first ``num_episodes`` kept attempts: the same for any worker count."""
+        kept = self.kept_attempts()[:num_episodes]
+        last = kept[-1] if kept else -1
+        dropped: dict[str, int] = {}
+        for attempt in self.rejected_attempts():
+            if attempt < last:
+                reason = json.loads(self._rejected_path(attempt).read_text())["reason"]
+                dropped[reason] = dropped.get(reason, 0) + 1
+        beyond = sum(1 for attempt in self.done_attempts() if attempt > last)
+        attempted = len(kept) + sum(dropped.values())
+        return GenerationOutcome(attempted=attempted, kept=len(kept), dropped=dropped, run_past_the_last=beyond)
 
     def load(self, attempt: int) -> Episode:
         return Episode.load(self._kept_path(attempt))

@@ -15,6 +15,7 @@ from igen_lerobot.core.exceptions import DatasetSchemaError
 from igen_lerobot.datasets.merge import merge_datasets
 from igen_lerobot.datasets.meta import simulation_origin
 from igen_lerobot.datasets.reader import load_episodes
+from igen_lerobot.datasets.spool import GenerationOutcome
 from igen_lerobot.datasets.writer import DatasetBuilder
 from igen_lerobot.generation.attempt import Attempt
 from igen_lerobot.generation.config_generate import GenerateConfig
@@ -48,6 +49,16 @@ def live_logger(viz: EpisodeLogger, spool, sources: list[Episode]):
         viz.log_episode_object(attempt, episode, source_paths=paths)
 
     return on_result
+
+
+def generation_record(outcome: GenerationOutcome) -> dict:
+    """The dataset's generation counts (``meta/igen.json``, the card): the same for any worker count."""
+    return {
+        "attempted": outcome.attempted,
+        "success_rate": outcome.success_rate,
+        "dropped": outcome.dropped,
+        "run_past_the_last_kept": outcome.run_past_the_last,
+    }
 
 
 def check_source_kinds(episodes: list[Episode], mode: GenerationMode, root: Path) -> None:
@@ -153,11 +164,7 @@ def generate(cfg: GenerateConfig) -> None:
             "source_kinds": dict(Counter(ep.kind for ep in episodes)),
             "policy": cfg.policy.path or "scripted",
             "config": draccus.encode(cfg),
-            "generation": {
-                "attempted": stats.attempted + stats.resumed_attempts,
-                "success_rate": stats.success_rate,
-                "dropped": builder.spool.rejection_reasons(),
-            },
+            "generation": generation_record(builder.spool.outcome(cfg.num_episodes)),
         },
     )
     if cfg.render.cameras:
