@@ -3,6 +3,8 @@
 Run:  MUJOCO_GL=egl .venv/bin/python benchmarks/bench_env.py [--tasks block_grasp nut_insertion] \
           [--steps 3000] [--repeats 3] [--robosuite] [--clock cpu]
 
+The physics limit is measured twice: from the state after a reset (the arm at rest) and from
+every state the timed loop visited (its contacts included), which is what the loop itself pays.
 Pinned to CPU 0 with single-threaded BLAS, so the number is per core; each figure is the median
 of ``--repeats`` runs, the tasks interleaved within a repeat (this VM's speed drifts by +-20%
 between runs). ``--robosuite`` also times robosuite's stock Lift task with its Panda OSC
@@ -48,18 +50,21 @@ def time_env(task: str, steps: int) -> dict:
 
     # env.step + observe, driven by the scripted base policy (what generation runs)
     policy = cfg.make_scripted_policy()
-    done, seed = 0, 0
+    done, seed, policy_s = 0, 0, 0.0
     t0 = _clock()
     while done < steps:
         obs = env.reset(seed)
         for _ in range(cfg.episode_length):
-            info = env.step(policy.act(obs))
+            t_act = _clock()
+            action = policy.act(obs)
+            policy_s += _clock() - t_act  # the agent's share, apart from the simulator's
+            info = env.step(action)
             obs = env.observe()
             done += 1
             if info.success or done >= steps:
                 break
         seed += 1
-    loop_s = _clock() - t0 - 0.0
+    loop_s = _clock() - t0
 
     # raw physics of the same model and state: 25 substeps per control step, no controller
     model, data = env.model, env.data
@@ -70,6 +75,10 @@ def time_env(task: str, steps: int) -> dict:
         mujoco.mj_step(model, data)
     raw_s = _clock() - t0
     raw_ctrl_rate = n_raw / raw_s / env.arm.substeps
+
+    # the same physics from the very states the timed loop visited (contacts included: a task whose
+    # insertion touches a lot costs more per substep than the arm at rest above measures)
+    states_limit = same_states_physics_limit(env, cfg, policy, steps)
 
     # scripted operator success on uncorrupted episodes
     clean = dataclasses.replace(cfg, corruption=NoNoise()).make_task_env()
@@ -82,9 +91,45 @@ def time_env(task: str, steps: int) -> dict:
         "mj_step_per_s": n_raw / raw_s,
         "physics_limit_control_steps_per_s": raw_ctrl_rate,
         "ratio_to_physics_limit": (steps / loop_s) / raw_ctrl_rate,
+        "physics_limit_same_states_control_steps_per_s": states_limit,
+        "ratio_to_physics_limit_same_states": (steps / loop_s) / states_limit,
+        "scripted_policy_ms_per_step": 1000 * policy_s / steps,
+        "ratio_to_physics_limit_without_policy": (steps / (loop_s - policy_s)) / raw_ctrl_rate,
         "substeps": env.arm.substeps,
         "scripted_operator_success_50_seeds": ok / 50,
     }
+
+
+def same_states_physics_limit(env, cfg, policy, steps: int) -> float:
+    """Control steps/s of physics alone, each timed from a state the control loop visited.
+
+    The loop's episodes are run again (untimed) saving MuJoCo's integration state before every
+    control step; then each state is restored and its substeps stepped with the controls it held.
+    """
+    model, data = env.model, env.data
+    kind = mujoco.mjtState.mjSTATE_INTEGRATION
+    size = mujoco.mj_stateSize(model, kind)
+    states, done, seed = [], 0, 0
+    while done < steps:
+        obs = env.reset(seed)
+        for _ in range(cfg.episode_length):
+            state = np.empty(size)
+            mujoco.mj_getState(model, data, state, kind)
+            states.append(state)
+            info = env.step(policy.act(obs))
+            obs = env.observe()
+            done += 1
+            if info.success or done >= steps:
+                break
+        seed += 1
+    physics_s = 0.0
+    for state in states:
+        mujoco.mj_setState(model, data, state, kind)
+        t0 = _clock()
+        for _ in range(env.arm.substeps):
+            mujoco.mj_step(model, data)
+        physics_s += _clock() - t0
+    return len(states) / physics_s
 
 
 def time_robosuite_lift(steps: int) -> dict:

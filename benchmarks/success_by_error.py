@@ -1,0 +1,64 @@
+"""Split evaluation reports' trials by the sign of one component of their pose error.
+
+Trial ``i`` of a report ran in the scene and error of ``episode_seed(seed, i)``, so each trial's
+error is sampled again here (no physics) and set beside its outcome. Used to read a table: in
+the in-hand tasks a learnt policy lets go at the seat of the target it *observes*, so an error
+that puts the target higher than it is (component 2 > 0) makes it let go in the air, a mistake
+the contact-triggered recoveries never start from.
+
+Run:  .venv/bin/python benchmarks/success_by_error.py REPORT.json [REPORT.json ...] [--component 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import draccus
+from lerobot.utils.import_utils import register_third_party_plugins
+
+from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.core.seeding import episode_seed
+
+
+def errors_of(report: dict) -> list[float]:
+    """Each trial's sampled pose error (one row per trial), from the report's task, error model and seed."""
+    config = task_config_class(report["task"])()
+    recorded = {k: v for k, v in report["corruption"].items() if k != "type"}  # the choice's name
+    if draccus.encode(config.corruption) != recorded:
+        raise SystemExit(
+            f"report error model {report['corruption']} is not the task's default {draccus.encode(config.corruption)}: "
+            "this script samples the default one"
+        )
+    env = config.make_task_env()
+    try:
+        rows = []
+        for i in range(report["n_trials"]):
+            env.reset(episode_seed(report["seed"], i))
+            rows.append(env.corruption.tolist())
+        return rows
+    finally:
+        env.close()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("reports", nargs="+", type=Path)
+    parser.add_argument("--component", type=int, default=2, help="which error component to split on (2: z)")
+    args = parser.parse_args()
+    register_third_party_plugins()
+    print("| report | checkpoint | error > 0: successes | error <= 0: successes |")
+    print("|---|---|---|---|")
+    for path in args.reports:
+        report = json.loads(path.read_text())
+        errors = [row[args.component] for row in errors_of(report)]
+        for result in report["results"]:
+            up = [ok for e, ok in zip(errors, result["per_trial"], strict=True) if e > 0]
+            down = [ok for e, ok in zip(errors, result["per_trial"], strict=True) if e <= 0]
+            name = Path(result["policy"]).parent.name
+            print(f"| {path} | {name} | {sum(up)}/{len(up)} | {sum(down)}/{len(down)} |")
+
+
+if __name__ == "__main__":
+    main()
