@@ -46,18 +46,35 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("reports", nargs="+", type=Path)
     parser.add_argument("--component", type=int, default=2, help="which error component to split on (2: z)")
+    parser.add_argument(
+        "--aligned_within",
+        type=float,
+        default=0.007,
+        help="[m] also count trials whose component is > 0 but whose other components are all within this",
+    )
     args = parser.parse_args()
     register_third_party_plugins()
+    aligned_lines = []
     print("| report | checkpoint | error > 0: successes | error <= 0: successes |")
     print("|---|---|---|---|")
     for path in args.reports:
         report = json.loads(path.read_text())
-        errors = [row[args.component] for row in errors_of(report)]
+        rows = errors_of(report)
+        errors = [row[args.component] for row in rows]
+        others = [max(abs(v) for j, v in enumerate(row) if j != args.component) for row in rows]
+        n_up = sum(e > 0 for e in errors)
+        aligned = sum(e > 0 and o < args.aligned_within for e, o in zip(errors, others, strict=True))
+        aligned_lines.append(
+            f"seed {report['seed']}: {n_up} of {len(rows)} trials have error component {args.component} > 0; "
+            f"{aligned} of them have every other component within {1000 * args.aligned_within:.0f} mm"
+        )
         for result in report["results"]:
             up = [ok for e, ok in zip(errors, result["per_trial"], strict=True) if e > 0]
             down = [ok for e, ok in zip(errors, result["per_trial"], strict=True) if e <= 0]
             name = Path(result["policy"]).parent.name
             print(f"| {path} | {name} | {sum(up)}/{len(up)} | {sum(down)}/{len(down)} |")
+    for line in dict.fromkeys(aligned_lines):  # once per trial set
+        print(line)
 
 
 if __name__ == "__main__":
