@@ -1,5 +1,7 @@
 """BC-RNN as a LeRobot policy plugin: registered, trained by lerobot-train, reloaded, acting."""
 
+import logging
+
 import numpy as np
 import pytest
 import torch
@@ -148,3 +150,44 @@ def test_cosine_schedule_anneals_the_rate_to_zero_over_the_training_steps():
     assert all(a >= b for a, b in zip(rates, rates[1:], strict=False))
     with pytest.raises(ConfigError, match="policy.lr_schedule must be one of"):
         BCRNNConfig(lr_schedule="linear")
+
+
+def test_std_tolerance_bounds_how_far_a_constant_input_is_amplified(caplog):
+    from lerobot.configs import FeatureType, PolicyFeature
+
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.processor_bc_rnn import make_bc_rnn_pre_post_processors
+
+    features = {
+        "observation.state": PolicyFeature(FeatureType.STATE, (2,)),
+        "observation.environment_state": PolicyFeature(FeatureType.ENV, (2,)),
+    }
+    stats = {  # the second env input never varied in the data (a fixed peg's height)
+        "observation.state": {"mean": np.array([0.5, 0.0]), "std": np.array([0.1, 0.2])},
+        "observation.environment_state": {"mean": np.array([0.0, 0.865]), "std": np.array([0.03, 0.0])},
+        "action": {"min": np.array([-1.0, -1.0]), "max": np.array([1.0, 1.0])},
+    }
+    error = 0.001  # a 1 mm observation error on the constant input
+
+    def normalised_error(tolerance: float) -> float:
+        config = BCRNNConfig(
+            obs_std_tolerance=tolerance,
+            input_features=features,
+            output_features={"action": PolicyFeature(FeatureType.ACTION, (2,))},
+        )
+        pre, _ = make_bc_rnn_pre_post_processors(config, stats)
+        obs = {
+            "observation.state": torch.tensor([[0.5, 0.0]]),
+            "observation.environment_state": torch.tensor([[0.0, 0.865 + error]]),
+        }
+        out = pre(obs)
+        return float(out["observation.environment_state"][0, 1])
+
+    with caplog.at_level(logging.WARNING):
+        assert normalised_error(0.0) > 1e4  # LeRobot's eps alone: the 1 mm error becomes ~1e5 std
+    assert "observation.environment_state[1]" in caplog.text and "obs_std_tolerance" in caplog.text
+    caplog.clear()
+    assert normalised_error(1e-3) == pytest.approx(1.0, rel=1e-3)  # robomimic's tolerance: one unit
+    assert "never vary" not in caplog.text  # nothing to warn about once the tolerance bounds it
+    with pytest.raises(Exception, match="obs_std_tolerance"):
+        BCRNNConfig(obs_std_tolerance=-1.0)

@@ -41,6 +41,10 @@ class BCRNNConfig(PreTrainedConfig):
             "ACTION": NormalizationMode.MIN_MAX,  # the GMM means are tanh-squashed into [-1, 1]
         }
     )
+    # [input units] added to every mean/std-normalised input's std (robomimic adds 1e-3 when it
+    # normalises). Without it, an input that never varies in the data (a fixed peg's height) gets
+    # std ~0 and any deviation at test time is multiplied by ~1e8.
+    obs_std_tolerance: float = 0.0
     optimizer_lr: float = 1e-3
     optimizer_weight_decay: float = 0.0
     optimizer_grad_clip_norm: float = 1e6  # robomimic does not clip gradients
@@ -60,6 +64,8 @@ class BCRNNConfig(PreTrainedConfig):
             raise ConfigError(f"policy.gmm_num_modes must be >= 1, got {self.gmm_num_modes}")
         if self.lr_schedule not in LR_SCHEDULES:
             raise ConfigError(f"policy.lr_schedule must be one of {list(LR_SCHEDULES)}, got {self.lr_schedule!r}")
+        if self.obs_std_tolerance < 0:
+            raise ConfigError(f"policy.obs_std_tolerance must be >= 0, got {self.obs_std_tolerance}")
         if self.n_obs_steps != 1:
             raise ConfigError("policy.n_obs_steps must be 1 for bc_rnn (the RNN carries the history)")
 

@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import logging
 from typing import Any
 
 import torch
+from lerobot.configs.types import NormalizationMode
 from lerobot.processor import PolicyAction, PolicyProcessorPipeline, make_default_pre_post_processors
 
 from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+
+logger = logging.getLogger(__name__)
+
+CONSTANT_STD = 1e-6  # [input units] below this an input counts as constant in the data
 
 
 def make_bc_rnn_pre_post_processors(
@@ -15,5 +21,55 @@ def make_bc_rnn_pre_post_processors(
 ) -> tuple[
     PolicyProcessorPipeline[dict[str, Any], dict[str, Any]], PolicyProcessorPipeline[PolicyAction, PolicyAction]
 ]:
-    """Normalise inputs (mean/std) and actions (min/max to [-1, 1]); unnormalise outputs."""
-    return make_default_pre_post_processors(config, dataset_stats, normalizer_device=config.device)
+    """Normalise inputs (mean/std) and actions (min/max to [-1, 1]); unnormalise outputs.
+
+    The stats saved with a checkpoint are the ones used here, tolerance included, so evaluation
+    normalises as training did.
+    """
+    return make_default_pre_post_processors(
+        config, with_std_tolerance(config, dataset_stats), normalizer_device=config.device
+    )
+
+
+def with_std_tolerance(
+    config: BCRNNConfig, stats: dict[str, dict[str, torch.Tensor]] | None
+) -> dict[str, dict[str, torch.Tensor]] | None:
+    """``stats`` with ``config.obs_std_tolerance`` added to the std of each mean/std-normalised input."""
+    if stats is None:
+        return stats
+    normalised = {
+        key
+        for key, feature in config.input_features.items()
+        if config.normalization_mapping.get(feature.type.value) is NormalizationMode.MEAN_STD
+    }
+    if config.obs_std_tolerance == 0:
+        warn_constant_inputs(stats, normalised)
+        return stats
+    out = dict(stats)
+    for key in normalised & set(stats):
+        std = torch.as_tensor(stats[key]["std"])
+        out[key] = {**stats[key], "std": std + config.obs_std_tolerance}
+    return out
+
+
+def warn_constant_inputs(stats: dict[str, dict[str, torch.Tensor]], keys: set[str]) -> list[str]:
+    """Name the inputs that never vary in the data; mean/std would blow up any deviation from them.
+
+    A fixed object's height or orientation is constant in demonstrations, its std ~1e-8; an
+    observation error of 1 mm on it then reaches the network as ~1e5 standard deviations.
+    """
+    found = []
+    for key in sorted(keys & set(stats)):
+        std = torch.as_tensor(stats[key]["std"]).flatten()
+        constant = [i for i, s in enumerate(std.tolist()) if s < CONSTANT_STD]
+        if constant:
+            found.append(f"{key}{constant}")
+    if found:
+        logger.warning(
+            "inputs that never vary in the training data (std < %g): %s. Mean/std normalisation divides any "
+            "deviation from them at run time by that std (LeRobot adds only 1e-8); --policy.obs_std_tolerance=1e-3 "
+            "(robomimic's value) bounds it",
+            CONSTANT_STD,
+            ", ".join(found),
+        )
+    return found
