@@ -169,19 +169,20 @@ def test_std_tolerance_bounds_how_far_a_constant_input_is_amplified(caplog):
     }
     error = 0.001  # a 1 mm observation error on the constant input
 
-    def normalised_error(tolerance: float) -> float:
+    def normalised_error(tolerance: float, constant_std: float = 0.0, index: int = 1) -> float:
         config = BCRNNConfig(
             obs_std_tolerance=tolerance,
+            constant_input_std=constant_std,
             input_features=features,
             output_features={"action": PolicyFeature(FeatureType.ACTION, (2,))},
         )
         pre, _ = make_bc_rnn_pre_post_processors(config, stats)
         obs = {
             "observation.state": torch.tensor([[0.5, 0.0]]),
-            "observation.environment_state": torch.tensor([[0.0, 0.865 + error]]),
+            "observation.environment_state": torch.tensor([[0.03, 0.865 + error]]),
         }
         out = pre(obs)
-        return float(out["observation.environment_state"][0, 1])
+        return float(out["observation.environment_state"][0, index])
 
     with caplog.at_level(logging.WARNING):
         assert normalised_error(0.0) > 1e4  # LeRobot's eps alone: the 1 mm error becomes ~1e5 std
@@ -189,5 +190,10 @@ def test_std_tolerance_bounds_how_far_a_constant_input_is_amplified(caplog):
     caplog.clear()
     assert normalised_error(1e-3) == pytest.approx(1.0, rel=1e-3)  # robomimic's tolerance: one unit
     assert "never vary" not in caplog.text  # nothing to warn about once the tolerance bounds it
+    # a constant input given std 1 keeps its deviation in its own units (1 mm -> 0.001); a varying one is untouched
+    assert normalised_error(0.0, constant_std=1.0) == pytest.approx(error, rel=1e-3)
+    assert normalised_error(0.0, constant_std=1.0, index=0) == pytest.approx(1.0, rel=1e-4)  # 0.03 at std 0.03
+    with pytest.raises(Exception, match="constant_input_std"):
+        BCRNNConfig(constant_input_std=-1.0)
     with pytest.raises(Exception, match="obs_std_tolerance"):
         BCRNNConfig(obs_std_tolerance=-1.0)

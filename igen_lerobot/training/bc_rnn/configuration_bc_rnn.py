@@ -45,6 +45,10 @@ class BCRNNConfig(PreTrainedConfig):
     # normalises). Without it, an input that never varies in the data (a fixed peg's height) gets
     # std ~0 and any deviation at test time is multiplied by ~1e8.
     obs_std_tolerance: float = 0.0
+    # [input units] the std given to an input that never varies in the data (std < 1e-6), 0: keep its
+    # ~0 std. 1.0 passes its deviations through in their own units (a flag's 0 -> 1, a height error
+    # in metres), as robomimic's unnormalised inputs do; inputs that vary keep mean/std.
+    constant_input_std: float = 0.0
     optimizer_lr: float = 1e-3
     optimizer_weight_decay: float = 0.0
     optimizer_grad_clip_norm: float = 1e6  # robomimic does not clip gradients
@@ -64,6 +68,8 @@ class BCRNNConfig(PreTrainedConfig):
             raise ConfigError(f"policy.gmm_num_modes must be >= 1, got {self.gmm_num_modes}")
         if self.lr_schedule not in LR_SCHEDULES:
             raise ConfigError(f"policy.lr_schedule must be one of {list(LR_SCHEDULES)}, got {self.lr_schedule!r}")
+        if self.constant_input_std < 0:
+            raise ConfigError(f"policy.constant_input_std must be >= 0, got {self.constant_input_std}")
         if self.obs_std_tolerance < 0:
             raise ConfigError(f"policy.obs_std_tolerance must be >= 0, got {self.obs_std_tolerance}")
         if self.n_obs_steps != 1:

@@ -42,12 +42,14 @@ def with_std_tolerance(
         for key, feature in config.input_features.items()
         if config.normalization_mapping.get(feature.type.value) is NormalizationMode.MEAN_STD
     }
-    if config.obs_std_tolerance == 0:
+    if config.obs_std_tolerance == 0 and config.constant_input_std == 0:
         warn_constant_inputs(stats, normalised)
         return stats
     out = dict(stats)
     for key in normalised & set(stats):
         std = torch.as_tensor(stats[key]["std"])
+        if config.constant_input_std > 0:  # constant inputs: only centred, their deviations kept in input units
+            std = torch.where(std < CONSTANT_STD, torch.full_like(std, config.constant_input_std), std)
         out[key] = {**stats[key], "std": std + config.obs_std_tolerance}
     return out
 
