@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Base policy of the Nut Insertion table trained three ways on the table's own base data (seed 1000,
 # 5000 steps, one thread): LeRobot's mean/std (the default), mean/std with robomimic's 1e-3 added to
-# each std, and no input normalisation (robomimic's default); each checkpoint tested on the table's
-# 50 test trials. Needs outputs/tables/nut_insertion/data/base (the table's "base" step).
+# each std, mean/std with std 1 for the inputs that never vary in the data, and no input
+# normalisation (robomimic's default); each checkpoint tested on the table's 50 test trials. Needs outputs/tables/nut_insertion/data/base (the table's "base" step).
 #   nice -n 10 bash benchmarks/bench_obs_normalisation.sh [out=outputs/obs_normalisation]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -22,4 +22,6 @@ mkdir -p "$out"
 train mean_std &
 train mean_std_tol --policy.obs_std_tolerance=0.001 &
 wait
-train identity '--policy.normalization_mapping={"STATE": "IDENTITY", "ENV": "IDENTITY", "ACTION": "MIN_MAX"}'
+train constant_std_1 --policy.constant_input_std=1.0 &
+train identity '--policy.normalization_mapping={"STATE": "IDENTITY", "ENV": "IDENTITY", "ACTION": "MIN_MAX"}' &
+wait
