@@ -193,6 +193,7 @@ def test_std_tolerance_bounds_how_far_a_constant_input_is_amplified(caplog):
     # a constant input given std 1 keeps its deviation in its own units (1 mm -> 0.001); a varying one is untouched
     assert normalised_error(0.0, constant_std=1.0) == pytest.approx(error, rel=1e-3)
     assert normalised_error(0.0, constant_std=1.0, index=0) == pytest.approx(1.0, rel=1e-4)  # 0.03 at std 0.03
+    assert BCRNNConfig().constant_input_std == 1.0  # the default since the Nut Insertion finding
     with pytest.raises(Exception, match="constant_input_std"):
         BCRNNConfig(constant_input_std=-1.0)
     with pytest.raises(Exception, match="obs_std_tolerance"):
