@@ -71,9 +71,12 @@ class EpisodeSpool:
     def done_attempts(self) -> set[int]:
         return set(self.kept_attempts()) | set(self.rejected_attempts())
 
-    def rejection_reasons(self) -> dict[str, int]:
+    def rejection_reasons(self, before: int | None = None) -> dict[str, int]:
+        """Why attempts were dropped, counted per reason (only attempts numbered below ``before``, if given)."""
         counts: dict[str, int] = {}
         for attempt in self.rejected_attempts():
+            if before is not None and attempt >= before:
+                continue
             reason = json.loads(self._rejected_path(attempt).read_text())["reason"]
             counts[reason] = counts.get(reason, 0) + 1
         return counts
@@ -82,11 +85,7 @@ class EpisodeSpool:
         """Counts behind the first ``num_episodes`` kept attempts: the same for any worker count."""
         kept = self.kept_attempts()[:num_episodes]
         last = kept[-1] if kept else -1
-        dropped: dict[str, int] = {}
-        for attempt in self.rejected_attempts():
-            if attempt < last:
-                reason = json.loads(self._rejected_path(attempt).read_text())["reason"]
-                dropped[reason] = dropped.get(reason, 0) + 1
+        dropped = self.rejection_reasons(before=last)
         beyond = sum(1 for attempt in self.done_attempts() if attempt > last)
         attempted = len(kept) + sum(dropped.values())
         return GenerationOutcome(attempted=attempted, kept=len(kept), dropped=dropped, run_past_the_last=beyond)

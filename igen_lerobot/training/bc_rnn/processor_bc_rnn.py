@@ -23,18 +23,20 @@ def make_bc_rnn_pre_post_processors(
 ]:
     """Normalise inputs (mean/std) and actions (min/max to [-1, 1]); unnormalise outputs.
 
-    The stats saved with a checkpoint are the ones used here, tolerance included, so evaluation
+    The stats saved with a checkpoint are the ones used here, adjustments included, so evaluation
     normalises as training did.
     """
-    return make_default_pre_post_processors(
-        config, with_std_tolerance(config, dataset_stats), normalizer_device=config.device
-    )
+    return make_default_pre_post_processors(config, input_stats(config, dataset_stats), normalizer_device=config.device)
 
 
-def with_std_tolerance(
+def input_stats(
     config: BCRNNConfig, stats: dict[str, dict[str, torch.Tensor]] | None
 ) -> dict[str, dict[str, torch.Tensor]] | None:
-    """``stats`` with ``config.obs_std_tolerance`` added to the std of each mean/std-normalised input."""
+    """``stats`` as BC-RNN normalises with them (the constant-input std, then the tolerance).
+
+    A mean/std-normalised input that never varies in the data gets ``config.constant_input_std``;
+    then every such input's std gets ``config.obs_std_tolerance`` added.
+    """
     if stats is None:
         return stats
     normalised = {
