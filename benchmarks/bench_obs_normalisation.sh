@@ -19,8 +19,8 @@ train() {
   grep -E "^(step|best)" "$out/$name.eval.log" | sed "s/^/$name: /"
 }
 mkdir -p "$out"
-train mean_std &
-train mean_std_tol --policy.obs_std_tolerance=0.001 &
+train mean_std --policy.constant_input_std=0 &  # LeRobot's own normalisation (the default before 2026-12-05)
+train mean_std_tol --policy.constant_input_std=0 --policy.obs_std_tolerance=0.001 &
 wait
 train constant_std_1 --policy.constant_input_std=1.0 &
 train identity '--policy.normalization_mapping={"STATE": "IDENTITY", "ENV": "IDENTITY", "ACTION": "MIN_MAX"}' &
