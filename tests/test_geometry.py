@@ -1,19 +1,23 @@
 """Pose math as properties (tolerance: 1e-9 on positions/rotations, float64)."""
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
+from igen_lerobot.core import geometry
 from igen_lerobot.core.geometry import (
     interpolate_poses,
     make_pose,
+    matrix_from_rotvec,
     pos_quat_to_pose,
     pose_inv,
     pose_to_pos_quat,
     quat_wxyz_to_xyzw,
     quat_xyzw_to_wxyz,
     rotation_angle,
+    rotvec_from_matrix,
     transform_segment,
 )
 
@@ -99,3 +103,43 @@ def test_quaternions_follow_mujocos_sign_convention(seed):
     theirs = np.empty(4)
     mujoco.mju_mat2Quat(theirs, rot.reshape(9))
     np.testing.assert_allclose(ours, theirs[[1, 2, 3, 0]], atol=1e-12)  # MuJoCo is scalar-first
+
+
+def _rotation_cases(seed: int) -> dict[str, np.ndarray]:
+    """Random rotations plus the edge cases of each conversion (identity, half turns, near-zero angles)."""
+    rng = np.random.default_rng(seed)
+    matrices = [*random_rotation_stack(rng, 200), np.eye(3), np.diag([1.0, -1.0, -1.0]), np.diag([-1.0, -1.0, 1.0])]
+    matrices.append(Rotation.from_rotvec([1e-12, -3e-13, 2e-12]).as_matrix())
+    return {
+        "matrices": np.stack(matrices),
+        "quats": np.concatenate([rng.normal(size=(200, 4)) * rng.uniform(0.2, 3.0, (200, 1)), np.eye(4)]),
+        "rotvecs": np.concatenate([rng.normal(size=(200, 3)) * 2.0, np.zeros((1, 3)), [[np.pi, 0.0, 0.0]]]),
+    }
+
+
+def random_rotation_stack(rng: np.random.Generator, n: int) -> np.ndarray:
+    return Rotation.from_quat(rng.normal(size=(n, 4))).as_matrix()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_rotation_conversions_give_scipys_exact_numbers(seed):
+    """The conversions skip scipy's array-API dispatch but must not change one bit of what it returns."""
+    assert geometry._compiled_rotations is not None, "the locked scipy has its compiled rotations: the fast path runs"
+    cases = _rotation_cases(seed)
+    for rot in cases["matrices"]:
+        pose = np.eye(4)
+        pose[:3, :3] = rot
+        _, quat = pose_to_pos_quat(pose)  # a non-contiguous 3x3 view of the pose
+        assert np.array_equal(quat, Rotation.from_matrix(rot).as_quat())
+        assert np.array_equal(rotvec_from_matrix(rot), Rotation.from_matrix(rot).as_rotvec())
+    poses = np.tile(np.eye(4), (len(cases["matrices"]), 1, 1))
+    poses[:, :3, :3] = cases["matrices"]
+    assert np.array_equal(pose_to_pos_quat(poses)[1], Rotation.from_matrix(cases["matrices"]).as_quat())
+    for quat in cases["quats"]:
+        assert np.array_equal(pos_quat_to_pose(np.zeros(3), quat)[:3, :3], Rotation.from_quat(quat).as_matrix())
+    stacked = pos_quat_to_pose(np.zeros((len(cases["quats"]), 3)), cases["quats"])
+    assert np.array_equal(stacked[:, :3, :3], Rotation.from_quat(cases["quats"]).as_matrix())
+    for rotvec in cases["rotvecs"]:
+        assert np.array_equal(matrix_from_rotvec(rotvec), Rotation.from_rotvec(rotvec).as_matrix())
+    # a list is taken as the public API takes it
+    assert np.array_equal(matrix_from_rotvec([0.1, 0.2, 0.3]), Rotation.from_rotvec([0.1, 0.2, 0.3]).as_matrix())

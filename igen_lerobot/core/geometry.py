@@ -18,6 +18,11 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+try:  # scipy's compiled conversions, the ones ``Rotation`` calls for numpy input (see _compiled)
+    from scipy.spatial.transform import _rotation_cy as _compiled_rotations
+except ImportError:  # pragma: no cover - a scipy without them: the public API, slower, same numbers
+    _compiled_rotations = None
+
 __all__ = [
     "make_pose",
     "pose_inv",
@@ -59,15 +64,24 @@ def pose_inv(pose: np.ndarray) -> np.ndarray:
 def pose_to_pos_quat(pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Split a pose (or stack) into position [m] and quaternion (x, y, z, w)."""
     pose = np.asarray(pose, dtype=float)
-    quat = Rotation.from_matrix(pose[..., :3, :3]).as_quat()
-    return pose[..., :3, 3].copy(), quat
+    rot = pose[..., :3, :3]
+    if _compiled_rotations is None or rot.ndim > 3:
+        return pose[..., :3, 3].copy(), Rotation.from_matrix(rot).as_quat()
+    quat = _compiled_rotations.from_matrix(rot, assume_valid=False)
+    quat = _compiled_rotations.as_quat(np.atleast_2d(quat), canonical=False, scalar_first=False)
+    return pose[..., :3, 3].copy(), quat[0] if rot.ndim == 2 else quat
 
 
 def pos_quat_to_pose(pos: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
     """Pose (or stack) from position [m] and quaternion (x, y, z, w); the quaternion is normalised."""
     pos = np.asarray(pos, dtype=float)
     quat = np.asarray(quat_xyzw, dtype=float)
-    rot = Rotation.from_quat(quat).as_matrix()
+    if _compiled_rotations is None or quat.ndim > 2:
+        rot = Rotation.from_quat(quat).as_matrix()
+    else:
+        normalised = _compiled_rotations.from_quat(np.atleast_2d(quat), normalize=True, copy=True, scalar_first=False)
+        rot = _compiled_rotations.as_matrix(normalised)
+        rot = rot[0] if quat.ndim == 1 else rot
     pose = np.zeros(pos.shape[:-1] + (4, 4))
     pose[..., :3, :3] = rot
     pose[..., :3, 3] = pos
@@ -162,12 +176,20 @@ def pose_vector(pose: np.ndarray) -> np.ndarray:
 
 def rotvec_from_matrix(rot: np.ndarray) -> np.ndarray:
     """Axis-angle vector [rad] (axis times angle) of a rotation matrix."""
-    return Rotation.from_matrix(np.asarray(rot, dtype=float)).as_rotvec()
+    rot = np.asarray(rot, dtype=float)
+    if _compiled_rotations is None or rot.ndim != 2:
+        return Rotation.from_matrix(rot).as_rotvec()
+    quat = _compiled_rotations.from_matrix(rot, assume_valid=False)
+    return _compiled_rotations.as_rotvec(quat[None], degrees=False)[0]
 
 
 def matrix_from_rotvec(rotvec: np.ndarray) -> np.ndarray:
     """Rotation matrix of an axis-angle vector [rad]."""
-    return Rotation.from_rotvec(np.asarray(rotvec, dtype=float)).as_matrix()
+    rotvec = np.asarray(rotvec, dtype=float)
+    if _compiled_rotations is None or rotvec.ndim != 1:
+        return Rotation.from_rotvec(rotvec).as_matrix()
+    quat = _compiled_rotations.from_rotvec(rotvec, degrees=False)
+    return _compiled_rotations.as_matrix(quat[None])[0]
 
 
 def rot_z(angle: float) -> np.ndarray:
