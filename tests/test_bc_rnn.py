@@ -76,6 +76,42 @@ def test_rnn_state_is_reset_every_horizon_steps():
     assert not torch.allclose(hidden_after[1], hidden_after[0])
 
 
+@pytest.mark.parametrize("rnn_type", ["LSTM", "GRU"])
+def test_a_batch_of_trials_steps_each_row_as_alone_where_the_rnn_allows(rnn_type):
+    """Grouped evaluation relies on torch's CPU LSTM computing each row the same for any batch size
+    (tolerance 0); its GRU does not, so a GRU policy declines grouping instead of changing numbers."""
+    from lerobot.configs import FeatureType, PolicyFeature
+
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.modeling_bc_rnn import BCRNNPolicy
+
+    torch.manual_seed(0)
+    config = BCRNNConfig(
+        rnn_type=rnn_type,
+        rnn_hidden_dim=33,
+        horizon=4,
+        input_features={"observation.state": PolicyFeature(FeatureType.STATE, (5,))},
+        output_features={"action": PolicyFeature(FeatureType.ACTION, (3,))},
+    )
+    policy = BCRNNPolicy(config)
+    inputs = torch.randn(9, 6, 5)  # 9 trials, 6 steps: past the horizon's reset
+    alone = []
+    for k in range(9):
+        policy.reset()
+        torch.manual_seed(100 + k)
+        alone.append(
+            torch.stack([policy.select_action({"observation.state": inputs[k : k + 1, t]})[0] for t in range(6)])
+        )
+    policy.reset()
+    generators = [torch.Generator().manual_seed(100 + k) for k in range(9)]
+    together = torch.stack(
+        [policy.select_action_per_trial({"observation.state": inputs[:, t]}, generators) for t in range(6)], dim=1
+    )
+    exact = all(torch.equal(together[k], alone[k]) for k in range(9))
+    assert policy.trials_batch_exactly == (rnn_type == "LSTM")
+    assert exact == (rnn_type == "LSTM")
+
+
 def test_lerobot_train_checkpoint_loads_and_acts_in_our_env(bc_rnn_checkpoint, block_grasp_env, source_demos):
     from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 

@@ -232,5 +232,119 @@ def test_igen_eval_workers_bad_input_names_the_fix():
 
     with pytest.raises(ConfigError, match="--workers must be >= 1"):
         EvalConfig(task="block_grasp", workers=0)
+    with pytest.raises(ConfigError, match="--trials_together must be >= 1"):
+        EvalConfig(task="block_grasp", trials_together=0)
     with pytest.raises(ConfigError, match="--workers=1"):
         EvalConfig(task="block_grasp", workers=2, rerun=RerunConfig(mode="save", path="x.rrd"))
+
+
+def test_trials_stepped_together_act_as_each_trial_alone(bc_rnn_checkpoint, block_grasp_config):
+    """``--trials_together``: one batched BC-RNN call per step for a group of trials must give each trial,
+    bit for bit (tolerance 0), the actions it gets alone after seeding from its own seed, whatever the
+    group's size and the trials beside it; otherwise grouping would change a table's numbers."""
+    import numpy as np
+
+    from igen_lerobot.evaluation.trials import rollout, rollout_together, steps_trials_together
+    from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+    policy = make_base_policy(PolicySourceConfig(path=str(bc_rnn_checkpoint)), block_grasp_config)
+    assert steps_trials_together(policy)
+    envs = [block_grasp_config.make_task_env() for _ in range(3)]
+    seeds, steps = [7, 8, 9], 25  # past BC-RNN's 10-step horizon, where its memory is reset
+    try:
+        alone = {}
+        for seed in seeds:
+            recording = _Recording(policy)
+            rollout(envs[0], recording, seed, steps)
+            alone[seed] = np.stack(recording.actions)
+        for group in ([7, 8, 9], [9, 7], [8]):
+            rows: list[list[np.ndarray]] = [[] for _ in group]
+            act_trials = policy.act_trials
+
+            def recorded(observations, rows=rows, act_trials=act_trials):
+                actions = act_trials(observations)
+                for row, action in zip(rows, actions, strict=True):
+                    row.append(action)
+                return actions
+
+            policy.act_trials = recorded
+            try:
+                outcomes = rollout_together(envs[: len(group)], policy, group, steps)
+            finally:
+                del policy.act_trials
+            assert outcomes == [(False, steps)] * len(group)  # a 3-step policy does not grasp
+            for seed, row in zip(group, rows, strict=True):
+                np.testing.assert_array_equal(np.stack(row), alone[seed])
+    finally:
+        for env in envs:
+            env.close()
+
+
+class _StepsTogether:
+    """The scripted policy behind the grouped interface: trials that end at different steps."""
+
+    steps_trials_together = True
+
+    def __init__(self, policy) -> None:
+        self.policy = policy
+
+    def start_trials(self, seeds) -> None:
+        self.policy.reset()
+
+    def act_trials(self, observations):
+        import numpy as np
+
+        return np.stack([self.policy.act(observation) for observation in observations])
+
+
+def test_a_group_of_trials_ends_each_one_where_it_ends_alone(block_grasp_config, block_grasp_env):
+    """Trials of one group succeed at different steps; each keeps its own outcome and step count (tolerance
+    0), in trial order, through evaluate() and through the worker pool."""
+    from igen_lerobot.evaluation.parallel import TrialPool
+    from igen_lerobot.training.policy_source import PolicySourceConfig
+
+    scripted = block_grasp_config.make_scripted_policy()
+    alone = evaluate(block_grasp_env, scripted, "scripted", 7, seed=7, max_steps=200, progress=False)
+    assert len(set(alone.per_trial_steps)) > 1
+    grouped = evaluate(
+        block_grasp_env,
+        _StepsTogether(scripted),
+        "scripted",
+        7,
+        seed=7,
+        max_steps=200,
+        progress=False,
+        together=3,
+        make_env=block_grasp_config.make_task_env,
+    )
+    assert grouped.per_trial == alone.per_trial and grouped.per_trial_steps == alone.per_trial_steps
+    with TrialPool(block_grasp_config, workers=2) as pool:  # the scripted policy runs one trial at a time
+        spread = pool.evaluate(PolicySourceConfig(), "scripted", 7, seed=7, max_steps=200, progress=False, together=3)
+    assert spread.per_trial_steps == alone.per_trial_steps
+
+
+def test_a_checkpoints_trials_in_worker_groups_match_one_process(bc_rnn_checkpoint, block_grasp_config):
+    """The pool steps a BC-RNN checkpoint's trials in groups: the same outcomes as one process, one by one."""
+    from igen_lerobot.evaluation.parallel import TrialPool
+    from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+    source = PolicySourceConfig(path=str(bc_rnn_checkpoint))
+    env = block_grasp_config.make_task_env()
+    try:
+        policy = make_base_policy(source, block_grasp_config)
+        alone = evaluate(env, policy, "ckpt", 5, seed=3, max_steps=30, progress=False)
+    finally:
+        env.close()
+    with TrialPool(block_grasp_config, workers=2) as pool:
+        grouped = pool.evaluate(source, "ckpt", 5, seed=3, max_steps=30, progress=False, together=3)
+    assert grouped.per_trial == alone.per_trial and grouped.per_trial_steps == alone.per_trial_steps
+
+
+def test_trial_groups_cover_every_trial_once_in_balanced_groups():
+    from igen_lerobot.evaluation.trials import trial_groups
+
+    for trials, workers, together in [(50, 2, 10), (50, 2, 25), (7, 2, 3), (1, 2, 10), (5, 1, 1)]:
+        groups = trial_groups(trials, workers, together)
+        assert [i for group in groups for i in group] == list(range(trials))
+        assert max(map(len, groups)) <= together and max(map(len, groups)) - min(map(len, groups)) <= 1
+    assert [len(g) for g in trial_groups(50, 2, 10)] == [8, 9, 8, 8, 9, 8]  # 6 groups: 3 per worker

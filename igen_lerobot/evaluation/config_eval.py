@@ -30,6 +30,10 @@ class EvalConfig:
     # processes running the trials, one simulation each: the same outcomes for any count, faster up to
     # one per core
     workers: int = 1
+    # trials one process steps together, one batched policy call per control step for all of them (a
+    # state-only BC-RNN checkpoint; other policies run one trial at a time): the same outcomes for any
+    # count, about half the cost of a BC-RNN evaluation (docs/benchmarks.md)
+    trials_together: int = 10
 
     def __post_init__(self) -> None:
         self.env = resolve_task_env(self.task, self.env)
@@ -41,5 +45,7 @@ class EvalConfig:
             raise ConfigError(f"--every must be >= 1, got {self.every}")
         if self.workers < 1:
             raise ConfigError(f"--workers must be >= 1, got {self.workers}")
+        if self.trials_together < 1:
+            raise ConfigError(f"--trials_together must be >= 1 (1: one trial at a time), got {self.trials_together}")
         if self.workers > 1 and self.rerun.enabled:
             raise ConfigError("--rerun logs every trial's frames from one process; drop --rerun or pass --workers=1")

@@ -66,7 +66,9 @@ def _run_workers(cfg: EvalConfig, targets: list[tuple[int | None, PolicySourceCo
     results = []
     with TrialPool(env_cfg, cfg.workers, env_cfg.image_cameras) as pool:
         for step, source in targets:
-            result = pool.evaluate(source, source.describe(), cfg.n_trials, cfg.seed, env_cfg.episode_length)
+            result = pool.evaluate(
+                source, source.describe(), cfg.n_trials, cfg.seed, env_cfg.episode_length, together=cfg.trials_together
+            )
             result.step = step
             results.append(result)
             print(_line(result))
@@ -100,6 +102,8 @@ def _run_here(cfg: EvalConfig, targets: list[tuple[int | None, PolicySourceConfi
                 on_trial=on_trial,
                 record_trials=viz is not None,
                 cameras=env_cfg.image_cameras,
+                together=cfg.trials_together,
+                make_env=env_cfg.make_task_env,
             )
             result.step = step
             results.append(result)

@@ -21,7 +21,14 @@ from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.exceptions import ConfigError, IgenError
 from igen_lerobot.core.processes import limit_threads, reap_forkserver
 from igen_lerobot.core.seeding import episode_seed
-from igen_lerobot.evaluation.trials import EvalResult, rollout, trials_result
+from igen_lerobot.evaluation.trials import (
+    EvalResult,
+    rollout,
+    rollout_together,
+    steps_trials_together,
+    trial_groups,
+    trials_result,
+)
 from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
 
 # one worker's env, kept across trials, and the policy it loaded last (by its config)
@@ -34,19 +41,24 @@ class EvalWorkerError(IgenError, RuntimeError):
 
 def _start_worker(env_config: TaskEnvConfig, cameras: CameraConfig | None) -> None:  # pragma: no cover
     limit_threads()
-    _worker.update(env_config=env_config, cameras=cameras, env=env_config.make_task_env(), source=None, policy=None)
+    _worker.update(env_config=env_config, cameras=cameras, envs=[env_config.make_task_env()], source=None, policy=None)
 
 
-def _run_trial(  # pragma: no cover
-    source: PolicySourceConfig, seed: int, index: int, max_steps: int
-) -> tuple[int, bool, int]:
+def _run_trials(  # pragma: no cover
+    source: PolicySourceConfig, seed: int, indices: list[int], max_steps: int
+) -> list[tuple[int, bool, int]]:
+    """One group of trials: stepped together when the policy can (see ``rollout_together``), else one by one."""
     if _worker["source"] != source:
         _worker["policy"] = make_base_policy(source, _worker["env_config"])
         _worker["source"] = source
-    success, steps = rollout(
-        _worker["env"], _worker["policy"], episode_seed(seed, index), max_steps, cameras=_worker["cameras"]
-    )
-    return index, success, steps
+    policy, envs = _worker["policy"], _worker["envs"]
+    seeds = [episode_seed(seed, i) for i in indices]
+    if len(indices) > 1 and steps_trials_together(policy):
+        envs += [_worker["env_config"].make_task_env() for _ in range(len(indices) - len(envs))]
+        outcomes = rollout_together(envs[: len(indices)], policy, seeds, max_steps)
+    else:
+        outcomes = [rollout(envs[0], policy, s, max_steps, cameras=_worker["cameras"]) for s in seeds]
+    return [(i, success, steps) for i, (success, steps) in zip(indices, outcomes, strict=True)]
 
 
 class TrialPool:
@@ -58,6 +70,7 @@ class TrialPool:
         # not plain fork: this process has torch's threads, and forking them can deadlock a child
         context = mp.get_context("forkserver")
         context.set_forkserver_preload([__name__, type(env_config).__module__])
+        self.workers = workers
         self._executor = ProcessPoolExecutor(
             max_workers=workers, mp_context=context, initializer=_start_worker, initargs=(env_config, cameras)
         )
@@ -73,21 +86,33 @@ class TrialPool:
         reap_forkserver()
 
     def evaluate(
-        self, source: PolicySourceConfig, name: str, trials: int, seed: int, max_steps: int, progress: bool = True
+        self,
+        source: PolicySourceConfig,
+        name: str,
+        trials: int,
+        seed: int,
+        max_steps: int,
+        progress: bool = True,
+        together: int = 1,
     ) -> EvalResult:
-        """Trials ``0..trials-1`` of ``source``, as :func:`~igen_lerobot.evaluation.trials.evaluate` runs them."""
+        """Trials ``0..trials-1`` of ``source``, as :func:`~igen_lerobot.evaluation.trials.evaluate` runs them.
+
+        ``together``: each worker steps up to that many trials at once when the policy can; the
+        outcomes are the same for any value.
+        """
         if trials < 1:
             raise ConfigError(f"eval trials must be >= 1, got {trials}")
         start = time.perf_counter()
-        futures = [self._executor.submit(_run_trial, source, seed, i, max_steps) for i in range(trials)]
+        groups = trial_groups(trials, self.workers, together)
+        futures = [self._executor.submit(_run_trials, source, seed, group, max_steps) for group in groups]
         outcomes: list[bool | None] = [None] * trials
         steps = [0] * trials
         try:
             with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
                 for future in as_completed(futures):
-                    index, success, n = future.result()
-                    outcomes[index], steps[index] = success, n
-                    bar.update()
+                    for index, success, n in future.result():
+                        outcomes[index], steps[index] = success, n
+                        bar.update()
                     bar.set_postfix(success=f"{sum(o is True for o in outcomes)}/{bar.n}")
         except BrokenProcessPool as error:
             raise EvalWorkerError(

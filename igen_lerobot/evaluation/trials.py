@@ -89,6 +89,46 @@ def rollout(
     return False, max_steps
 
 
+def trial_groups(trials: int, workers: int, together: int) -> list[list[int]]:
+    """Trials ``0..trials-1`` in contiguous groups of at most ``together``, as many as a multiple of ``workers``.
+
+    Groups of near-equal size, so that ``workers`` processes taking one group at a time finish together.
+    """
+    count = workers * math.ceil(trials / (workers * together))
+    bounds = [round(k * trials / count) for k in range(count + 1)]
+    return [list(range(a, b)) for a, b in zip(bounds, bounds[1:], strict=False) if b > a]
+
+
+def steps_trials_together(policy: Policy) -> bool:
+    """Whether ``policy`` can run several trials in one batched call (:func:`rollout_together`)."""
+    return bool(getattr(policy, "steps_trials_together", False))
+
+
+def rollout_together(envs: list[TaskEnv], policy: Policy, seeds: list[int], max_steps: int) -> list[tuple[bool, int]]:
+    """Trial k on ``envs[k]`` with ``seeds[k]``, all stepped together: one policy call per step for all of them.
+
+    Each trial's outcome is the one :func:`rollout` gives it alone (the policy keeps trials apart,
+    see ``act_trials``); what changes is the cost: a recurrent policy's per-step matrix products, the
+    larger half of an evaluation step, are paid once for the batch. A trial that has ended keeps
+    its row with its last observation until the others end.
+    """
+    observations = [env.reset(seed) for env, seed in zip(envs, seeds, strict=True)]
+    policy.start_trials(seeds)
+    outcomes: list[tuple[bool, int] | None] = [None] * len(envs)
+    for step in range(1, max_steps + 1):
+        actions = policy.act_trials(observations)
+        for k, env in enumerate(envs):
+            if outcomes[k] is not None:
+                continue
+            if env.step(actions[k]).success:
+                outcomes[k] = (True, step)
+            else:
+                observations[k] = env.observe()
+        if all(outcome is not None for outcome in outcomes):
+            break
+    return [outcome if outcome is not None else (False, max_steps) for outcome in outcomes]
+
+
 def evaluate(
     env: TaskEnv,
     policy: Policy,
@@ -100,16 +140,38 @@ def evaluate(
     on_trial: Callable[[int, bool, int, Episode | None], None] | None = None,
     record_trials: bool = False,
     cameras: CameraConfig | None = None,
+    together: int = 1,
+    make_env: Callable[[], TaskEnv] | None = None,
 ) -> EvalResult:
     """Roll ``policy`` out for ``trials`` seeded trials.
 
     ``on_trial(i, success, steps, episode)`` runs after each; ``episode`` holds the trial's frames
-    when ``record_trials`` (for live views), else None.
+    when ``record_trials`` (for live views), else None. ``together``: up to that many trials run at
+    once (:func:`rollout_together`, on ``env`` and envs from ``make_env``) when the policy can and
+    nothing is recorded or rendered; the outcomes are the same for any value.
     """
     if trials < 1:
         raise ConfigError(f"eval trials must be >= 1, got {trials}")
     start = time.perf_counter()
     outcomes, steps = [], []
+    grouped = together > 1 and make_env is not None and not record_trials and not (cameras and cameras.cameras)
+    if grouped and steps_trials_together(policy):
+        envs = [env]
+        with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
+            for group in trial_groups(trials, 1, together):
+                envs += [make_env() for _ in range(len(group) - len(envs))]
+                seeds = [episode_seed(seed, i) for i in group]
+                ended = rollout_together(envs[: len(group)], policy, seeds, max_steps)
+                for i, (success, n) in zip(group, ended, strict=True):
+                    outcomes.append(success)
+                    steps.append(n)
+                    if on_trial is not None:
+                        on_trial(i, success, n, None)
+                bar.update(len(group))
+                bar.set_postfix(success=f"{sum(outcomes)}/{len(outcomes)}")
+        for extra in envs[1:]:
+            extra.close()
+        return trials_result(name, outcomes, steps, time.perf_counter() - start)
     with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
         for i in range(trials):
             recorder = EpisodeRecorder(env) if record_trials else None

@@ -103,6 +103,40 @@ class LeRobotCheckpointPolicy:
         """Seed torch's generator, which LeRobot's policies sample from (see ``core.agents.seed_policy``)."""
         self._torch.manual_seed(seed)
 
+    @property
+    def steps_trials_together(self) -> bool:
+        """Whether :meth:`act_trials` runs.
+
+        It needs a state-only policy that steps a batch of trials exactly as each alone, with draws per
+        trial (BC-RNN's LSTM on CPU).
+        """
+        return not self.image_keys and bool(getattr(self.policy, "trials_batch_exactly", False))
+
+    def start_trials(self, seeds: list[int]) -> None:
+        """Start one trial per seed, stepped together by :meth:`act_trials`; trial k draws from its own seed."""
+        torch = self._torch
+        self.policy.reset()
+        self._generators = [torch.Generator().manual_seed(int(seed)) for seed in seeds]
+
+    def act_trials(self, observations: list[dict[str, np.ndarray]]) -> np.ndarray:
+        """Actions (B, action_dim) for the trials :meth:`start_trials` began, one observation each.
+
+        Trial k's actions are, bit for bit, what :meth:`act` gives it alone after ``seed(seeds[k])``
+        (the normalisers are per element, the policy keeps each row apart): a table's numbers do not
+        depend on how trials are grouped.
+        """
+        torch = self._torch
+        batch = {
+            OBS_STATE: torch.from_numpy(np.stack([np.asarray(o[OBS_STATE], dtype=np.float32) for o in observations])),
+            OBS_ENV_STATE: torch.from_numpy(
+                np.stack([np.asarray(o[OBS_ENV_STATE], dtype=np.float32) for o in observations])
+            ),
+            "task": [self.instruction] * len(observations),
+        }
+        with torch.inference_mode():
+            actions = self.policy.select_action_per_trial(self.preprocessor(batch), self._generators)
+            return self.postprocessor(actions).cpu().numpy().astype(float)
+
     def act(self, observation: dict[str, np.ndarray]) -> np.ndarray:
         torch = self._torch
         batch = {

@@ -44,15 +44,20 @@ class GMMHead(nn.Module):
         components = Independent(Normal(means, scales), 1)
         return MixtureSameFamily(Categorical(logits=logits), components)
 
-    def sample(self, features: Tensor, low_noise: bool = False) -> Tensor:
-        """A draw from the mixture, without building distribution objects (3x faster per control step)."""
+    def sample(self, features: Tensor, low_noise: bool = False, generator: torch.Generator | None = None) -> Tensor:
+        """A draw from the mixture, without building distribution objects (3x faster per control step).
+
+        ``generator``: where the draws come from (default: torch's global generator).
+        """
         logits, means, scales = self.parameters_of(features, low_noise)
         flat = logits.reshape(-1, self.num_modes)
-        mode = torch.multinomial(torch.softmax(flat, dim=-1), 1).reshape(*logits.shape[:-1], 1, 1)
-        index = mode.expand(*logits.shape[:-1], 1, self.action_dim)
+        mode = torch.multinomial(torch.softmax(flat, dim=-1), 1, generator=generator)
+        index = mode.reshape(*logits.shape[:-1], 1, 1).expand(*logits.shape[:-1], 1, self.action_dim)
         mean = means.gather(-2, index).squeeze(-2)
         scale = scales.gather(-2, index).squeeze(-2)
-        return mean + scale * torch.randn_like(mean)
+        if generator is None:
+            return mean + scale * torch.randn_like(mean)
+        return mean + scale * torch.randn(mean.shape, generator=generator, dtype=mean.dtype, device=mean.device)
 
 
 class BCRNNPolicy(PreTrainedPolicy):
@@ -121,3 +126,36 @@ class BCRNNPolicy(PreTrainedPolicy):
         out, self._hidden = self.rnn(inputs, self._hidden)
         self._steps += 1
         return self.head.sample(self.mlp(out), low_noise=self.config.low_noise_eval)[:, 0]
+
+    @property
+    def trials_batch_exactly(self) -> bool:
+        """Whether :meth:`select_action_per_trial` gives each row, bit for bit, what it gets alone.
+
+        On CPU torch's LSTM keeps every row's arithmetic the same for any batch size; its GRU does not
+        (measured: tests/test_bc_rnn.py).
+        """
+        return self.config.rnn_type == "LSTM" and self.config.device in (None, "cpu")
+
+    @torch.no_grad()
+    def select_action_per_trial(self, batch: dict[str, Tensor], generators: list[torch.Generator]) -> Tensor:
+        """:meth:`select_action` for B trials stepped together, row ``k`` drawing from ``generators[k]``.
+
+        Row ``k`` gets, bit for bit, what ``select_action`` gives trial ``k`` alone after
+        ``torch.manual_seed`` with its seed: the LSTM, the one costly part, runs on the whole batch
+        (on CPU its rows do not depend on each other or on the batch size: tests/test_bc_rnn.py); the
+        head runs row by row, because a matrix product over B rows may sum in another order than
+        over one, and each row draws from its own generator.
+        """
+        self.eval()
+        if self._steps % self.config.horizon == 0:
+            self._hidden = None
+        inputs = self._inputs(batch).unsqueeze(1)  # (B, 1, D)
+        out, self._hidden = self.rnn(inputs, self._hidden)
+        self._steps += 1
+        low_noise = self.config.low_noise_eval
+        # each row copied to a buffer of its own, aligned as a lone trial's output is: a view at row k's
+        # offset takes other vectorised paths through the head's products and gives other last bits
+        rows = [
+            self.head.sample(self.mlp(out[k : k + 1].clone()), low_noise, g)[:, 0] for k, g in enumerate(generators)
+        ]
+        return torch.cat(rows)
