@@ -320,6 +320,8 @@ def test_a_group_of_trials_ends_each_one_where_it_ends_alone(block_grasp_config,
     assert grouped.per_trial == alone.per_trial and grouped.per_trial_steps == alone.per_trial_steps
     with TrialPool(block_grasp_config, workers=2) as pool:  # the scripted policy runs one trial at a time
         spread = pool.evaluate(PolicySourceConfig(), "scripted", 7, seed=7, max_steps=200, progress=False, together=3)
+        # a policy that cannot step trials together is shared out one trial at a time, for balance
+        assert pool.trial_groups(PolicySourceConfig(), 7, together=3) == [[i] for i in range(7)]
     assert spread.per_trial_steps == alone.per_trial_steps
 
 
@@ -337,6 +339,7 @@ def test_a_checkpoints_trials_in_worker_groups_match_one_process(bc_rnn_checkpoi
         env.close()
     with TrialPool(block_grasp_config, workers=2) as pool:
         grouped = pool.evaluate(source, "ckpt", 5, seed=3, max_steps=30, progress=False, together=3)
+        assert max(map(len, pool.trial_groups(source, 5, together=3))) > 1
     assert grouped.per_trial == alone.per_trial and grouped.per_trial_steps == alone.per_trial_steps
 
 

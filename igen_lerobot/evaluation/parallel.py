@@ -16,6 +16,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 from tqdm import tqdm
 
+from igen_lerobot.core.agents import Policy
 from igen_lerobot.core.cameras import CameraConfig
 from igen_lerobot.core.env_config import TaskEnvConfig
 from igen_lerobot.core.exceptions import ConfigError, IgenError
@@ -44,14 +45,24 @@ def _start_worker(env_config: TaskEnvConfig, cameras: CameraConfig | None) -> No
     _worker.update(env_config=env_config, cameras=cameras, envs=[env_config.make_task_env()], source=None, policy=None)
 
 
+def _worker_policy(source: PolicySourceConfig) -> Policy:  # pragma: no cover
+    """``source``'s policy in this worker, made once per source."""
+    if _worker["source"] != source:
+        _worker["policy"] = make_base_policy(source, _worker["env_config"])
+        _worker["source"] = source
+    return _worker["policy"]
+
+
+def _source_steps_trials_together(source: PolicySourceConfig) -> bool:  # pragma: no cover
+    """Whether ``source``'s policy can step several trials at once, asked of the worker that will run it."""
+    return steps_trials_together(_worker_policy(source))
+
+
 def _run_trials(  # pragma: no cover
     source: PolicySourceConfig, seed: int, indices: list[int], max_steps: int
 ) -> list[tuple[int, bool, int]]:
     """One group of trials: stepped together when the policy can (see ``rollout_together``), else one by one."""
-    if _worker["source"] != source:
-        _worker["policy"] = make_base_policy(source, _worker["env_config"])
-        _worker["source"] = source
-    policy, envs = _worker["policy"], _worker["envs"]
+    policy, envs = _worker_policy(source), _worker["envs"]
     seeds = [episode_seed(seed, i) for i in indices]
     if len(indices) > 1 and steps_trials_together(policy):
         envs += [_worker["env_config"].make_task_env() for _ in range(len(indices) - len(envs))]
@@ -85,6 +96,16 @@ class TrialPool:
         self._executor.shutdown(wait=True, cancel_futures=True)
         reap_forkserver()
 
+    def trial_groups(self, source: PolicySourceConfig, trials: int, together: int) -> list[list[int]]:
+        """How ``evaluate`` shares ``source``'s trials among the workers.
+
+        Groups of up to ``together`` when the policy steps trials together; else one trial per group, so
+        that a worker which finishes early takes the next trial rather than waiting on a whole group.
+        """
+        if together > 1 and not self._executor.submit(_source_steps_trials_together, source).result():
+            together = 1
+        return trial_groups(trials, self.workers, together)
+
     def evaluate(
         self,
         source: PolicySourceConfig,
@@ -103,11 +124,11 @@ class TrialPool:
         if trials < 1:
             raise ConfigError(f"eval trials must be >= 1, got {trials}")
         start = time.perf_counter()
-        groups = trial_groups(trials, self.workers, together)
-        futures = [self._executor.submit(_run_trials, source, seed, group, max_steps) for group in groups]
         outcomes: list[bool | None] = [None] * trials
         steps = [0] * trials
         try:
+            groups = self.trial_groups(source, trials, together)
+            futures = [self._executor.submit(_run_trials, source, seed, group, max_steps) for group in groups]
             with tqdm(total=trials, desc=f"eval {name}", unit="trial", disable=not progress) as bar:
                 for future in as_completed(futures):
                     for index, success, n in future.result():
