@@ -17,7 +17,7 @@ TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 
 # config fields added after tables were published that change no number (where records are kept,
 # whether weights are made again): a published config without them is still whole
-NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored")
+NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings")
 
 # torch threads of every table's trainings unless --train.threads says otherwise: fixed, so that a machine
 # with more cores trains the same weights; 2, what every earlier table trained with (torch's default on
@@ -82,6 +82,10 @@ class TableConfig:
     # train again the runs whose numbers were restored from the ledger, so that their checkpoints are on
     # this machine (igen-rehearse reads them); training is deterministic, so the weights are those tested
     retrain_restored: bool = False
+    # take a training from another table in the same parent folder (full and partial observability,
+    # the scaling table) when its data and command are the same: deterministic training would make the
+    # same weights. Linked, recorded with its source's time and commit in step_reused.json; evaluated anew
+    reuse_trainings: bool = True
     # the markdown page of every table; each table's JSON (and an optional <name>.notes.md with a reading
     # of it) lives in the folder of the same name (docs/results/), and the page is rendered from all of them
     results: str = "docs/results.md"

@@ -186,6 +186,19 @@ def interrupted_part(result: dict) -> str:
     )
 
 
+def reused_part(result: dict) -> list[str]:
+    """Trainings taken from another table (identical data and command), which the times above count as made."""
+    reused = result.get("step_reused") or {}
+    if not reused:
+        return []
+    tables = sorted({Path(source).parents[2].name for source in reused.values()})
+    return [
+        f"- Reused: {len(reused)} training{'' if len(reused) == 1 else 's'} taken from {', '.join(tables)}, "
+        "where the same data and command made them (deterministic training: the same weights); their "
+        "times and commits above are those of the trainings taken, and each was evaluated in this table."
+    ]
+
+
 def provenance_lines(result: dict) -> list[str]:
     """How a recorded run was made: its code versions and machines, its wall time and every command."""
     return [
@@ -194,6 +207,7 @@ def provenance_lines(result: dict) -> list[str]:
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min{interrupted_part(result)}.",
         cpu_line(result),
+        *reused_part(result),
         "",
         "Commands:",
         "",

@@ -53,8 +53,17 @@ from igen_lerobot.experiments.table_steps import (
     variant_label,
     variant_part,
 )
+from igen_lerobot.experiments.training_reuse import (
+    KEY_FILE,
+    find_identical_training,
+    link_training,
+    step_records_of,
+    training_key,
+    write_key,
+)
 from igen_lerobot.training.lerobot_train import (
     final_checkpoint,
+    last_saved_step,
     run_command,
     step_checkpoint,
     train_command,
@@ -74,6 +83,7 @@ RESUMABLE_CHANGES = (
     "dry_run",
     "ledger_dir",
     "retrain_restored",
+    "reuse_trainings",
 )
 
 
@@ -115,6 +125,10 @@ class StepRunner:
         # look cheaper than it was
         self.interrupted_file = self.out / "step_interrupted_times.json"
         self.interrupted: dict[str, float] = _read_json(self.interrupted_file, {})
+        # step -> the training of another table it was taken from (training_reuse); its time and
+        # commit above are that training's, so the table's cost still reads as if made from scratch
+        self.reused_file = self.out / "step_reused.json"
+        self.reused: dict[str, str] = _read_json(self.reused_file, {})
 
     def data(self, name: str) -> Path:
         return self.out / "data" / name
@@ -134,7 +148,7 @@ class StepRunner:
         ``env``: variables the command runs with, recorded in front of it as a shell would take them.
         """
         env = env or {}
-        shown = shlex.join([*(f"{k}={v}" for k, v in env.items()), Path(command[0]).name, *command[1:]])
+        shown = shell_command(command, env)
         self.commands.append({"step": name, "command": shown})
         if self.dry_run:
             return
@@ -171,7 +185,9 @@ class StepRunner:
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
             self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
             self.versions[name] = step_code
+            self.reused.pop(name, None)  # made here this time
             self.out.mkdir(parents=True, exist_ok=True)
+            self.reused_file.write_text(json.dumps(self.reused, indent=2))
             self.timings_file.write_text(json.dumps(self.timings, indent=2))
             self.cpu_times_file.write_text(json.dumps(self.cpu_times, indent=2))
             self.versions_file.write_text(json.dumps(self.versions, indent=2))
@@ -180,6 +196,37 @@ class StepRunner:
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
+
+    def reuse(
+        self, name: str, command: list[str], done: Path, source: Path, output_dir: Path, env: dict[str, str]
+    ) -> None:
+        """Take step ``name`` (a training into ``output_dir``) from ``source``, an identical finished training.
+
+        Recorded as the command that would make it, with the source's times and commit, and named in
+        ``step_reused.json``.
+        """
+        self.commands.append({"step": name, "command": shell_command(command, env)})
+        if self.dry_run or done.exists():
+            return
+        logger.info("%s: the same data and command as %s; its checkpoints are linked in", name, source)
+        link_training(source, output_dir)
+        self.executed.append(name)
+        _, records = step_records_of(source)
+        own = {
+            "step_times.json": self.timings,
+            "step_cpu_times.json": self.cpu_times,
+            "step_commits.json": self.versions,
+            "step_interrupted_times.json": self.interrupted,
+        }
+        for file, entries in own.items():
+            if file in records:
+                entries[name] = records[file]
+        self.reused[name] = str(source)
+        self.out.mkdir(parents=True, exist_ok=True)
+        for file, entries in {**own, "step_reused.json": self.reused}.items():
+            (self.out / file).write_text(json.dumps(entries, indent=2))
+        self.ledger.keep(done)
+        self.ledger.keep_step_records()
 
     def record(self, started: float, recorded: Path) -> dict:
         """What made the result about to be written to ``recorded``: commits, commands, times.
@@ -197,6 +244,9 @@ class StepRunner:
             "step_cpu_s": {step: t for step, t in self.cpu_times.items() if step in ran},
             "step_interrupted_s": {step: t for step, t in self.interrupted.items() if step in ran},
         }
+        reused = {step: source for step, source in self.reused.items() if step in ran}
+        if reused:
+            record["step_reused"] = reused
         keep_assembly_record(record, recorded, self.executed)
         return record
 
@@ -221,6 +271,11 @@ class TableRun(StepRunner):
         self.choose_on = paper.choose_on if paper is not None else ""
         if not cfg.dry_run:
             self.ledger.keep(self.out / "table_config.json")
+
+
+def shell_command(command: list[str], env: dict[str, str]) -> str:
+    """``command`` as the table records it: its env in front, as a shell takes it, and the tool by name."""
+    return shlex.join([*(f"{k}={v}" for k, v in env.items()), Path(command[0]).name, *command[1:]])
 
 
 def cpu_seconds() -> float:
@@ -471,7 +526,18 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     may_skip = not (weights_needed or run.cfg.retrain_restored or run.dry_run or done.exists())
     if may_skip and evaluation_on_record(run.out, run.columns, variant, seed):
         done = validation_report(run.out, variant, seed)  # its numbers stand: no checkpoint is read again
-    run.run(f"train_{variant}_seed{seed}", command, done, execute, env=train_env(cfg))
+    name, env = f"train_{variant}_seed{seed}", train_env(cfg)
+    key, source = None, None
+    if run.cfg.reuse_trainings and not run.dry_run and not done.exists() and last_saved_step(out) is None:
+        key = training_key(command, env, dataset, out)
+        source = find_identical_training(run.out.parent, key, out, cfg.steps)
+    if source is not None:
+        run.reuse(name, command, done, source, out, env)
+    else:
+        run.run(name, command, done, execute, env=env)
+    if not run.dry_run and (final / "config.json").exists() and not (out / KEY_FILE).exists():
+        # marked for a sibling table that would train the same (also a training finished before keys were)
+        write_key(out, key or training_key(command, env, dataset, out), source)
     return final
 
 

@@ -1,0 +1,109 @@
+"""Trainings a table takes from a sibling table: the same data and the same command make the same weights.
+
+Tables of one task share rows whose training data do not depend on the table: Base and MG Demo are
+demonstrations under full and partial observability alike, and the scaling table's base policy is
+the main table's. Training is deterministic at a fixed thread count (the same data, seed and command
+give the same weights: docs/benchmarks.md), so a finished training of another table under the same
+parent folder whose key matches is linked in rather than made again; each table still evaluates it
+in its own environment. The key is the training command with this run's paths taken out, its
+environment, and a digest of the dataset's bytes that training reads.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+from pathlib import Path
+
+from igen_lerobot.datasets.meta import IGEN_META_FILE
+from igen_lerobot.training.lerobot_train import final_checkpoint
+
+KEY_FILE = "training_key.json"
+STATS_FILE = "meta/stats.json"
+# where a link is being made: a stopped link leaves this, never a checkpoints/ that looks whole
+PARTIAL_CHECKPOINTS = "checkpoints.partial"
+
+
+def dataset_digest(root: Path) -> str:
+    """A digest of what ``lerobot-train`` reads of the dataset at ``root``.
+
+    ``meta/igen.json`` is left out (provenance: the command and reveal mode that made it, which
+    training never reads), and ``meta/stats.json`` is read as numbers, not bytes.
+    """
+    digest = hashlib.sha256()
+    files = sorted(p for p in Path(root).rglob("*") if p.is_file())
+    for path in files:
+        relative = path.relative_to(root).as_posix()
+        if relative == IGEN_META_FILE:
+            continue
+        data = path.read_bytes()
+        if relative == STATS_FILE:
+            data = json.dumps(json.loads(data), sort_keys=True).encode()
+        digest.update(relative.encode() + b"\0" + hashlib.sha256(data).digest())
+    return digest.hexdigest()
+
+
+def training_key(command: list[str], env: dict[str, str], dataset: Path, output_dir: Path) -> str:
+    """What decides a training's weights: its command without this run's paths, its env and its data."""
+    swaps = [(str(output_dir), "<output_dir>"), (str(dataset), "<dataset>"), (f"local/{dataset.name}", "<repo_id>")]
+    args = [Path(command[0]).name]
+    for arg in command[1:]:
+        for path, placeholder in swaps:
+            arg = arg.replace(path, placeholder)
+        args.append(arg)
+    what = {"command": args, "env": dict(sorted(env.items())), "data": dataset_digest(dataset)}
+    return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()
+
+
+def write_key(output_dir: Path, key: str, reused_from: Path | None = None) -> None:
+    """Mark a finished training with its key, so that a sibling table can find it."""
+    record = {"key": key, **({"reused_from": str(reused_from)} if reused_from is not None else {})}
+    (output_dir / KEY_FILE).write_text(json.dumps(record, indent=2))
+
+
+def find_identical_training(tables_root: Path, key: str, output_dir: Path, steps: int) -> Path | None:
+    """A finished training of a table under ``tables_root`` with ``key`` (None: there is none)."""
+    own = output_dir.resolve()
+    for marker in sorted(Path(tables_root).glob(f"*/train/*/seed*/{KEY_FILE}")):
+        candidate = marker.parent
+        if candidate.resolve() == own or json.loads(marker.read_text()).get("key") != key:
+            continue
+        if (final_checkpoint(candidate, steps) / "config.json").exists():
+            return candidate
+    return None
+
+
+def _link_or_copy(source: str, destination: str) -> None:
+    try:
+        os.link(source, destination)
+    except OSError:  # another file system
+        shutil.copy2(source, destination)
+
+
+def link_training(source: Path, output_dir: Path) -> None:
+    """Give ``output_dir`` the checkpoints of ``source`` (hard links: no copy, and the source may be deleted)."""
+    partial = output_dir / PARTIAL_CHECKPOINTS
+    shutil.rmtree(partial, ignore_errors=True)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    shutil.copytree(source / "checkpoints", partial, symlinks=True, copy_function=_link_or_copy)
+    partial.rename(output_dir / "checkpoints")
+
+
+def step_records_of(training: Path) -> tuple[str, dict[str, dict]]:
+    """The step that made ``training`` (``<table>/train/<variant>/seed<n>``) and its table's records of it.
+
+    Returns the step's name and, per record file (``step_times.json``, ...), the step's entry where it has one.
+    """
+    from igen_lerobot.experiments.ledger import STEP_RECORDS
+
+    table = training.parents[2]
+    step = f"train_{training.parent.name}_{training.name}"
+    records = {}
+    for name in STEP_RECORDS:
+        path = table / name
+        entries = json.loads(path.read_text()) if path.exists() else {}
+        if step in entries:
+            records[name] = entries[step]
+    return step, records

@@ -1,0 +1,113 @@
+"""A table takes a sibling table's training when the data and command are the same, and only then."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from igen_lerobot.experiments.training_reuse import KEY_FILE, dataset_digest, training_key
+
+ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
+
+
+def _table(out: Path, results: Path, *extra: str) -> subprocess.CompletedProcess:
+    command = [
+        str(Path(sys.executable).parent / "igen-table"),
+        "--variants=[base]",
+        "--train_seeds=[7]",
+        "--source_episodes=2",
+        "--base_demos=3",
+        "--train.steps=2",
+        "--train.save_freq=1",
+        "--train.batch_size=8",
+        "--train.num_workers=0",
+        "--n_trials=1",
+        "--n_val_trials=1",
+        "--workers=1",
+        "--in_process=true",
+        f"--output_dir={out}",
+        f"--results={results}",
+        *extra,
+    ]
+    return subprocess.run(command, capture_output=True, text=True, timeout=300, env=ENV)
+
+
+def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp_path):
+    tables, results = tmp_path / "tables", tmp_path / "results.md"
+    first = _table(tables / "first", results)
+    assert first.returncode == 0, first.stderr[-4000:]
+    made = tables / "first" / "train" / "base" / "seed7"
+    assert json.loads((made / KEY_FILE).read_text()).keys() == {"key"}
+
+    second = _table(tables / "second", results)
+    assert second.returncode == 0, second.stderr[-4000:]
+    taken = tables / "second" / "train" / "base" / "seed7"
+    assert json.loads((tables / "second" / "step_reused.json").read_text()) == {"train_base_seed7": str(made)}
+    assert json.loads((taken / KEY_FILE).read_text()) == {
+        **json.loads((made / KEY_FILE).read_text()),
+        "reused_from": str(made),
+    }
+    # every checkpoint is the same file (hard links), so the weights are those the first table tested
+    for step in ("000001", "000002"):
+        weights = Path("checkpoints", step, "pretrained_model", "model.safetensors")
+        assert os.stat(made / weights).st_ino == os.stat(taken / weights).st_ino
+    # its cost and commit are the training's; its evaluations are this table's own
+    for records in ("step_times.json", "step_cpu_times.json", "step_commits.json"):
+        made_records = json.loads((tables / "first" / records).read_text())
+        taken_records = json.loads((tables / "second" / records).read_text())
+        assert taken_records["train_base_seed7"] == made_records["train_base_seed7"]
+        assert {"validate_base_seed7", "test_base_seed7"} <= taken_records.keys()
+    report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
+    assert report["step_reused"] == {"train_base_seed7": str(made)}
+    assert "- Reused: 1 training taken from first" in results.read_text()
+
+    # another command (more steps) is another training: made, not taken
+    third = _table(tables / "third", results, "--train.steps=3")
+    assert third.returncode == 0, third.stderr[-4000:]
+    assert json.loads((tables / "third" / "step_reused.json").read_text()) == {}
+    made_again = tables / "third" / "train" / "base" / "seed7" / "checkpoints" / "000002"
+    assert (
+        os.stat(made_again / "pretrained_model" / "model.safetensors").st_ino
+        != os.stat(made / "checkpoints" / "000002" / "pretrained_model" / "model.safetensors").st_ino
+    )
+
+    # a table that is told not to reuse trains its own
+    fourth = _table(tables / "fourth", results, "--reuse_trainings=false")
+    assert fourth.returncode == 0, fourth.stderr[-4000:]
+    assert json.loads((tables / "fourth" / "step_reused.json").read_text()) == {}
+
+
+def _dataset(root: Path, data: bytes, stats: dict, meta: dict) -> Path:
+    (root / "data" / "chunk-000").mkdir(parents=True)
+    (root / "meta").mkdir()
+    (root / "data" / "chunk-000" / "file-000.parquet").write_bytes(data)
+    (root / "meta" / "stats.json").write_text(json.dumps(stats))
+    (root / "meta" / "igen.json").write_text(json.dumps(meta))
+    return root
+
+
+def test_the_key_is_the_data_and_the_command_not_the_paths_or_provenance(tmp_path):
+    stats = {"action": {"mean": [0.1, 0.2]}, "observation.state": {"std": [1.0]}}
+    a = _dataset(tmp_path / "a" / "data" / "train_base", b"rows", stats, {"reveal": "full"})
+    # the same numbers written in another key order, another provenance, another folder: the same data
+    reordered = dict(reversed(stats.items()))
+    b = _dataset(tmp_path / "b" / "data" / "train_base", b"rows", reordered, {"reveal": "direction"})
+    changed = _dataset(tmp_path / "c" / "data" / "train_base", b"rowz", stats, {"reveal": "full"})
+    assert dataset_digest(a) == dataset_digest(b) != dataset_digest(changed)
+
+    def key(dataset: Path, out: Path, steps: int = 5000, threads: str = "1") -> str:
+        command = [
+            "/venv/bin/lerobot-train",
+            f"--dataset.repo_id=local/{dataset.name}",
+            f"--dataset.root={dataset}",
+            f"--output_dir={out}",
+            f"--steps={steps}",
+        ]
+        return training_key(command, {"OMP_NUM_THREADS": threads}, dataset, out)
+
+    same = key(a, tmp_path / "a" / "train" / "base" / "seed7")
+    assert key(b, tmp_path / "b" / "train" / "base" / "seed7") == same
+    assert key(changed, tmp_path / "c" / "train" / "base" / "seed7") != same
+    assert key(a, tmp_path / "a" / "train" / "base" / "seed7", steps=6000) != same
+    assert key(a, tmp_path / "a" / "train" / "base" / "seed7", threads="2") != same
