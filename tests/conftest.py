@@ -107,6 +107,36 @@ def bc_rnn_checkpoint(source_demos, tmp_path_factory):
     return lerobot_train(cfg, source_demos, "local/block_grasp_demos", tmp_path_factory.mktemp("train") / "bc_rnn")
 
 
+@pytest.fixture()
+def tiny_table():
+    """Runs ``igen-table`` on Block Grasp at the smallest sizes that still make every step.
+
+    Called as ``tiny_table(output_dir, results_page, *more_flags, timeout=300)``; returns the finished
+    process. The rows, seeds and checkpoints are the caller's flags.
+    """
+    import sys
+
+    def run(out: Path, results: Path, *flags: str, timeout: float = 300) -> subprocess.CompletedProcess:
+        command = [
+            str(Path(sys.executable).parent / "igen-table"),
+            "--source_episodes=2",
+            "--base_demos=4",
+            "--train.steps=2",
+            "--train.batch_size=8",
+            "--train.num_workers=0",
+            "--n_trials=1",
+            "--n_val_trials=1",
+            "--workers=1",
+            "--in_process=true",
+            f"--output_dir={out}",
+            f"--results={results}",
+            *flags,
+        ]
+        return subprocess.run(command, capture_output=True, text=True, timeout=timeout, env=os.environ)
+
+    return run
+
+
 # Tests that run a robot or a person in wall-clock time (franky-sim's 1 kHz arm, LeRobot's
 # record/replay/rollout loops, key presses on Xvfb): they run on their own, after the rest, so a
 # parallel test never steals the cycles their timing depends on (see the Makefile's test target).

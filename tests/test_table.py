@@ -8,7 +8,6 @@ the full table is a documented command (docs/results.md)."""
 import json
 import os
 import subprocess
-import sys
 import time
 from dataclasses import asdict
 from pathlib import Path
@@ -24,10 +23,8 @@ from igen_lerobot.experiments.provenance import code_version, provenance_problem
 from igen_lerobot.experiments.table_steps import LABELS
 from igen_lerobot.training.config_train import TrainConfig
 
-ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
 
-
-def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
+def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path, tiny_table):
     """All seven rows on one training seed, then a resume that adds a second seed to two rows.
 
     The resume must redo nothing the first run finished, train only the new seed's runs, and pool
@@ -36,22 +33,7 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     from lerobot_env_igen.block_grasp.spec import SPEC
 
     out, results = tmp_path / "table", tmp_path / "results.md"
-    cmd = [
-        str(Path(sys.executable).parent / "igen-table"),
-        "--source_episodes=2",
-        "--base_demos=4",
-        "--generated=3",
-        "--train.steps=2",
-        "--train.batch_size=8",
-        "--train.num_workers=0",
-        "--n_trials=1",
-        "--n_val_trials=1",
-        "--workers=1",
-        "--in_process=true",
-        f"--output_dir={out}",
-        f"--results={results}",
-    ]
-    first = subprocess.run([*cmd, "--train_seeds=[7]"], capture_output=True, text=True, timeout=360, env=ENV)
+    first = tiny_table(out, results, "--generated=3", "--train_seeds=[7]", timeout=360)
     assert first.returncode == 0, first.stderr[-4000:]
 
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
@@ -107,9 +89,7 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
         assert np.allclose(ep.env_state[0, believed] - ep.true_object_pose[0, :3], ep.corruption, atol=1e-5)
 
     # resume with a second seed on two rows: nothing finished is redone, the new seed trains its own runs
-    again = subprocess.run(
-        [*cmd, "--train_seeds=[7,8]", "--variants=[base,igen]"], capture_output=True, text=True, timeout=180, env=ENV
-    )
+    again = tiny_table(out, results, "--generated=3", "--train_seeds=[7,8]", "--variants=[base,igen]", timeout=180)
     assert again.returncode == 0, again.stderr[-4000:]
     resumed = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
     times = json.loads((out / "step_times.json").read_text())
@@ -134,9 +114,7 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path):
     # a rerun with every step done (a chain of tables resuming) leaves the table's record as it was:
     # not re-stamped with the rerun's commit and its seconds of wall time
     (tmp_path / "results" / "block_grasp.json").write_text(json.dumps({**resumed, "code": {"commit": "f" * 40}}))
-    third = subprocess.run(
-        [*cmd, "--train_seeds=[7,8]", "--variants=[base,igen]"], capture_output=True, text=True, timeout=180, env=ENV
-    )
+    third = tiny_table(out, results, "--generated=3", "--train_seeds=[7,8]", "--variants=[base,igen]", timeout=180)
     assert third.returncode == 0, third.stderr[-4000:]
     unchanged = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
     assert unchanged["code"] == {"commit": "f" * 40}

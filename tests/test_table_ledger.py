@@ -2,11 +2,7 @@
 and a run on an empty output folder restores them and trains only what generation needs again."""
 
 import json
-import os
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
@@ -14,30 +10,11 @@ from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.experiments.ledger import STEP_RECORDS, Ledger
 from igen_lerobot.experiments.table import chosen_checkpoint
 
-ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
 
-
-def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data_policy(tmp_path):
+def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data_policy(tmp_path, tiny_table):
     out, ledger, results = tmp_path / "table", tmp_path / "ledger", tmp_path / "results.md"
-    cmd = [
-        str(Path(sys.executable).parent / "igen-table"),
-        "--variants=[base]",
-        "--train_seeds=[7,8]",
-        "--source_episodes=2",
-        "--base_demos=4",
-        "--train.steps=2",
-        "--train.save_freq=1",
-        "--train.batch_size=8",
-        "--train.num_workers=0",
-        "--n_trials=1",
-        "--n_val_trials=1",
-        "--workers=1",
-        "--in_process=true",
-        f"--output_dir={out}",
-        f"--results={results}",
-        f"--ledger_dir={ledger}",
-    ]
-    first = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=ENV)
+    flags = ("--variants=[base]", "--train_seeds=[7,8]", "--train.save_freq=1", f"--ledger_dir={ledger}")
+    first = tiny_table(out, results, *flags)
     assert first.returncode == 0, first.stderr[-4000:]
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
 
@@ -54,7 +31,7 @@ def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data
 
     # the machine is lost: only the ledger is left
     shutil.rmtree(out)
-    again = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=ENV)
+    again = tiny_table(out, results, *flags)
     assert again.returncode == 0, again.stderr[-4000:]
     resumed = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
     # seed 8's numbers are read back from the ledger; it is neither trained nor evaluated again
@@ -77,7 +54,7 @@ def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data
     # a rehearsal reads the chosen checkpoints: missing, they are named with the flag that makes them again
     with pytest.raises(ConfigError, match="--retrain_restored=true"):
         chosen_checkpoint(out, "base", 8)
-    third = subprocess.run([*cmd, "--retrain_restored=true"], capture_output=True, text=True, timeout=300, env=ENV)
+    third = tiny_table(out, results, *flags, "--retrain_restored=true")
     assert third.returncode == 0, third.stderr[-4000:]
     step, checkpoint = chosen_checkpoint(out, "base", 8)
     assert (checkpoint / "config.json").exists()

@@ -2,45 +2,21 @@
 
 import json
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 from igen_lerobot.experiments.training_reuse import KEY_FILE, dataset_digest, training_key
 
-ENV = {**os.environ, "MUJOCO_GL": "egl", "HF_HUB_OFFLINE": "1"}
+ONE_RUN = ("--variants=[base]", "--train_seeds=[7]", "--train.save_freq=1")
 
 
-def _table(out: Path, results: Path, *extra: str) -> subprocess.CompletedProcess:
-    command = [
-        str(Path(sys.executable).parent / "igen-table"),
-        "--variants=[base]",
-        "--train_seeds=[7]",
-        "--source_episodes=2",
-        "--base_demos=3",
-        "--train.steps=2",
-        "--train.save_freq=1",
-        "--train.batch_size=8",
-        "--train.num_workers=0",
-        "--n_trials=1",
-        "--n_val_trials=1",
-        "--workers=1",
-        "--in_process=true",
-        f"--output_dir={out}",
-        f"--results={results}",
-        *extra,
-    ]
-    return subprocess.run(command, capture_output=True, text=True, timeout=300, env=ENV)
-
-
-def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp_path):
+def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp_path, tiny_table):
     tables, results = tmp_path / "tables", tmp_path / "results.md"
-    first = _table(tables / "first", results)
+    first = tiny_table(tables / "first", results, *ONE_RUN)
     assert first.returncode == 0, first.stderr[-4000:]
     made = tables / "first" / "train" / "base" / "seed7"
     assert json.loads((made / KEY_FILE).read_text()).keys() == {"key"}
 
-    second = _table(tables / "second", results)
+    second = tiny_table(tables / "second", results, *ONE_RUN)
     assert second.returncode == 0, second.stderr[-4000:]
     taken = tables / "second" / "train" / "base" / "seed7"
     assert json.loads((tables / "second" / "step_reused.json").read_text()) == {"train_base_seed7": str(made)}
@@ -63,7 +39,7 @@ def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp
     assert "- Reused: 1 training taken from first" in results.read_text()
 
     # another command (more steps) is another training: made, not taken
-    third = _table(tables / "third", results, "--train.steps=3")
+    third = tiny_table(tables / "third", results, *ONE_RUN, "--train.steps=3")
     assert third.returncode == 0, third.stderr[-4000:]
     assert json.loads((tables / "third" / "step_reused.json").read_text()) == {}
     made_again = tables / "third" / "train" / "base" / "seed7" / "checkpoints" / "000002"
@@ -73,7 +49,7 @@ def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp
     )
 
     # a table that is told not to reuse trains its own
-    fourth = _table(tables / "fourth", results, "--reuse_trainings=false")
+    fourth = tiny_table(tables / "fourth", results, *ONE_RUN, "--reuse_trainings=false")
     assert fourth.returncode == 0, fourth.stderr[-4000:]
     assert json.loads((tables / "fourth" / "step_reused.json").read_text()) == {}
 
