@@ -10,7 +10,8 @@
 #
 # Two lanes: start it a second time while the first runs. A lane locks the table it runs (flock, let
 # go when the lane dies) and the other lane skips that table for the next; a rehearsal runs only
-# when no other lane is alive (franky runs in real time), and is skipped otherwise. The tables after
+# when no other lane is alive (franky runs in real time), and is skipped otherwise; a lane started while
+# it runs waits for it to end before its next table. The tables after
 # Block Grasp train at one torch thread, so two lanes' trainings share the two cores without the
 # collapse of two 2-thread pools and give the weights they would alone (docs/benchmarks.md).
 #
@@ -30,13 +31,18 @@
 # rehearsal reads its table's checkpoints, so that table trains again the runs it restores
 # (--retrain_restored=true: deterministic, the weights that were tested).
 #
+# Tables of one task share some trainings (Base and MG Demo of the full and partial tables, the
+# scaling table's base policy and its I-Gen 1000 row): a table takes a finished training of a table
+# beside it with the same data and command instead of making it again (igen-table --reuse_trainings,
+# its records name the source) and evaluates it in its own environment.
+#
 # Every row of a table trains the same way: its budget (the in-hand tasks and Nut-and-Peg train 5000
 # steps, Block Grasp the paper's 2000, Block Grasp on randomised arms 6000), its thread count (Block
 # Grasp 2, made before the lanes; every later table 1) plus PROTOCOL, the settings every table shares.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=${OUT_ROOT:-outputs/tables}
-bin=.venv/bin
+bin=${BIN:-.venv/bin}  # where igen-table and igen-rehearse are (tests give stand-ins that only log their runs)
 PROTOCOL=(${PROTOCOL:-})
 long=(--train.steps=5000 --train.save_freq=1000 --train.threads=1)
 # the four arm randomisations of benchmarks/randomization_settings.sh, as igen-table's --randomize list
@@ -86,7 +92,11 @@ for name in "${names[@]}"; do
     if [ "${DRY_RUN:-false}" = true ]; then echo "${command[*]}"; continue; fi
     [ -e "$table/table_config.json" ] && [ -n "$(ls "$table"/results/*.json 2>/dev/null)" ] \
       || { echo "$(date +%T) $name: its table $table is not finished; skipped (rerun when it is)"; continue; }
-    ! other_lane_alive || { echo "$(date +%T) $name: runs alone, and another lane is running; skipped"; continue; }
+    exec {alone}> "$locks/alone.lock" && flock -x "$alone"  # a lane started from now on waits for it
+    if other_lane_alive; then
+      exec {alone}>&-
+      echo "$(date +%T) $name: runs alone, and another lane is running; skipped"; continue
+    fi
   else
     if [ -e "docs/results/$name.json" ] && [ ! -e "$root/$name/table_config.json" ] \
       && [[ " ${REDO:-} " != *" $name "* && "${REDO:-}" != all ]]; then
@@ -97,9 +107,12 @@ for name in "${names[@]}"; do
       --ledger_dir="docs/results/ledger/$name" --dry_run="${DRY_RUN:-false}")
   fi
   if [ "${DRY_RUN:-false}" = true ]; then echo "$(date +%T) $name: ${command[*]}"; "${command[@]}"; continue; fi
+  # a rehearsal another lane runs must run alone: wait for it to end before starting a table
+  is_rehearsal "$name" || flock -s "$locks/alone.lock" true
   status=0
   LOG=$root/$name.log flock -n -E 75 "$locks/$name.lock" bash -c 'echo "$(date +%T) $0: $*"; "$@" >> "$LOG" 2>&1' \
     "$name" "${command[@]}" || status=$?
+  ! is_rehearsal "$name" || exec {alone}>&-
   if [ "$status" = 75 ]; then echo "$(date +%T) $name: another lane is running it; next"; continue; fi
   [ "$status" = 0 ] || { echo "$(date +%T) $name: failed (exit $status); log $root/$name.log"; exit "$status"; }
 done
