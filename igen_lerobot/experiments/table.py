@@ -57,7 +57,7 @@ from igen_lerobot.experiments.training_reuse import (
     KEY_FILE,
     find_identical_training,
     link_training,
-    step_records_of,
+    records_of_training,
     training_key,
     write_key,
 )
@@ -175,9 +175,7 @@ class StepRunner:
                         ).returncode
         except KeyboardInterrupt:
             self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
-            self.out.mkdir(parents=True, exist_ok=True)
-            self.interrupted_file.write_text(json.dumps(self.interrupted, indent=2))
-            self.ledger.keep_step_records()
+            self._write_step_records()
             logger.info("%s: stopped; rerun to resume it", name)
             raise
         if code == 0 and done.exists():
@@ -186,13 +184,8 @@ class StepRunner:
             self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
             self.versions[name] = step_code
             self.reused.pop(name, None)  # made here this time
-            self.out.mkdir(parents=True, exist_ok=True)
-            self.reused_file.write_text(json.dumps(self.reused, indent=2))
-            self.timings_file.write_text(json.dumps(self.timings, indent=2))
-            self.cpu_times_file.write_text(json.dumps(self.cpu_times, indent=2))
-            self.versions_file.write_text(json.dumps(self.versions, indent=2))
+            self._write_step_records()
             self.ledger.keep(done)
-            self.ledger.keep_step_records()
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
@@ -206,26 +199,30 @@ class StepRunner:
         ``step_reused.json``.
         """
         self.commands.append({"step": name, "command": shell_command(command, env)})
-        if self.dry_run or done.exists():
-            return
         logger.info("%s: the same data and command as %s; its checkpoints are linked in", name, source)
         link_training(source, output_dir)
         self.executed.append(name)
-        _, records = step_records_of(source)
-        own = {
+        own = self._step_records()
+        for file, entry in records_of_training(source).items():
+            own[file][name] = entry
+        self.reused[name] = str(source)
+        self._write_step_records()
+        self.ledger.keep(done)
+
+    def _step_records(self) -> dict[str, dict]:
+        """Each step-record file (``STEP_RECORDS``) and the dict this runner keeps of it."""
+        return {
             "step_times.json": self.timings,
             "step_cpu_times.json": self.cpu_times,
             "step_commits.json": self.versions,
             "step_interrupted_times.json": self.interrupted,
+            "step_reused.json": self.reused,
         }
-        for file, entries in own.items():
-            if file in records:
-                entries[name] = records[file]
-        self.reused[name] = str(source)
+
+    def _write_step_records(self) -> None:
         self.out.mkdir(parents=True, exist_ok=True)
-        for file, entries in {**own, "step_reused.json": self.reused}.items():
+        for file, entries in self._step_records().items():
             (self.out / file).write_text(json.dumps(entries, indent=2))
-        self.ledger.keep(done)
         self.ledger.keep_step_records()
 
     def record(self, started: float, recorded: Path) -> dict:

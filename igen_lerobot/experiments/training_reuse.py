@@ -21,6 +21,7 @@ from igen_lerobot.datasets.meta import IGEN_META_FILE
 from igen_lerobot.training.lerobot_train import final_checkpoint
 
 KEY_FILE = "training_key.json"
+REUSED_FILE = "step_reused.json"  # a table's record of the trainings it took
 STATS_FILE = "meta/stats.json"
 # where a link is being made: a stopped link leaves this, never a checkpoints/ that looks whole
 PARTIAL_CHECKPOINTS = "checkpoints.partial"
@@ -91,10 +92,11 @@ def link_training(source: Path, output_dir: Path) -> None:
     partial.rename(output_dir / "checkpoints")
 
 
-def step_records_of(training: Path) -> tuple[str, dict[str, dict]]:
-    """The step that made ``training`` (``<table>/train/<variant>/seed<n>``) and its table's records of it.
+def records_of_training(training: Path) -> dict[str, object]:
+    """Its table's step records of ``training`` (``<table>/train/<variant>/seed<n>``): its time, CPU time, commit.
 
-    Returns the step's name and, per record file (``step_times.json``, ...), the step's entry where it has one.
+    Per record file that has an entry for the step that made it; whether that step was itself taken
+    from another table is not carried over (the new step names its own source).
     """
     from igen_lerobot.experiments.ledger import STEP_RECORDS
 
@@ -104,6 +106,6 @@ def step_records_of(training: Path) -> tuple[str, dict[str, dict]]:
     for name in STEP_RECORDS:
         path = table / name
         entries = json.loads(path.read_text()) if path.exists() else {}
-        if step in entries:
+        if step in entries and name != REUSED_FILE:
             records[name] = entries[step]
-    return step, records
+    return records
