@@ -20,12 +20,13 @@ from pathlib import Path
 logger = logging.getLogger(__name__)
 
 # step -> value records (times, commits) a run keeps beside its outputs
+REUSED_FILE = "step_reused.json"  # the trainings a table took from another (training_reuse)
 STEP_RECORDS = (
     "step_times.json",
     "step_cpu_times.json",
     "step_commits.json",
     "step_interrupted_times.json",
-    "step_reused.json",
+    REUSED_FILE,
 )
 # the run's own settings, and the folder of its evaluation reports: what else the ledger keeps
 KEPT_FILES = ("table_config.json",)

@@ -40,7 +40,7 @@ from igen_lerobot.core.paper import safe_name
 from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
 from igen_lerobot.experiments.config_table import TableConfig
-from igen_lerobot.experiments.ledger import Ledger
+from igen_lerobot.experiments.ledger import REUSED_FILE, Ledger
 from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import (
@@ -127,7 +127,7 @@ class StepRunner:
         self.interrupted: dict[str, float] = _read_json(self.interrupted_file, {})
         # step -> the training of another table it was taken from (training_reuse); its time and
         # commit above are that training's, so the table's cost still reads as if made from scratch
-        self.reused_file = self.out / "step_reused.json"
+        self.reused_file = self.out / REUSED_FILE
         self.reused: dict[str, str] = _read_json(self.reused_file, {})
 
     def data(self, name: str) -> Path:
@@ -216,7 +216,7 @@ class StepRunner:
             "step_cpu_times.json": self.cpu_times,
             "step_commits.json": self.versions,
             "step_interrupted_times.json": self.interrupted,
-            "step_reused.json": self.reused,
+            REUSED_FILE: self.reused,
         }
 
     def _write_step_records(self) -> None:

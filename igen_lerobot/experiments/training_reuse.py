@@ -18,10 +18,10 @@ import shutil
 from pathlib import Path
 
 from igen_lerobot.datasets.meta import IGEN_META_FILE
+from igen_lerobot.experiments.ledger import REUSED_FILE, STEP_RECORDS
 from igen_lerobot.training.lerobot_train import final_checkpoint
 
 KEY_FILE = "training_key.json"
-REUSED_FILE = "step_reused.json"  # a table's record of the trainings it took
 STATS_FILE = "meta/stats.json"
 # where a link is being made: a stopped link leaves this, never a checkpoints/ that looks whole
 PARTIAL_CHECKPOINTS = "checkpoints.partial"
@@ -98,8 +98,6 @@ def records_of_training(training: Path) -> dict[str, object]:
     Per record file that has an entry for the step that made it; whether that step was itself taken
     from another table is not carried over (the new step names its own source).
     """
-    from igen_lerobot.experiments.ledger import STEP_RECORDS
-
     table = training.parents[2]
     step = f"train_{training.parent.name}_{training.name}"
     records = {}
