@@ -1,11 +1,14 @@
 """BC-RNN as a LeRobot policy plugin: registered, trained by lerobot-train, reloaded, acting."""
 
+import json
 import logging
+from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
+from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.datasets.reader import load_episodes
 
 
@@ -234,3 +237,45 @@ def test_std_tolerance_bounds_how_far_a_constant_input_is_amplified(caplog):
         BCRNNConfig(constant_input_std=-1.0)
     with pytest.raises(Exception, match="obs_std_tolerance"):
         BCRNNConfig(obs_std_tolerance=-1.0)
+
+
+def test_another_datasets_statistics_normalise_the_inputs_and_the_actions_keep_their_own(tmp_path):
+    """``--policy.observation_stats=<D>``: a row normalises its inputs with D's statistics (where its own
+    were made tiny by a few added episodes) and its actions with its own; a bad root names the flag."""
+    from lerobot.configs import FeatureType, PolicyFeature
+
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.processor_bc_rnn import make_bc_rnn_pre_post_processors
+
+    features = {"observation.environment_state": PolicyFeature(FeatureType.ENV, (2,))}
+    own = {  # the peg height varies only in 10 added episodes: std 1.3 mm
+        "observation.environment_state": {"mean": np.array([0.0, 0.864]), "std": np.array([0.03, 0.0013])},
+        "action": {"min": np.array([-0.5]), "max": np.array([0.5])},
+    }
+    base = tmp_path / "base"
+    (base / "meta").mkdir(parents=True)
+    d_stats = {"observation.environment_state": {"mean": [0.01, 0.865], "std": [0.02, 0.0]}}
+    (base / "meta" / "stats.json").write_text(json.dumps(d_stats))
+
+    def processors(root: Path | None):
+        config = BCRNNConfig(
+            observation_stats=None if root is None else str(root),
+            input_features=features,
+            output_features={"action": PolicyFeature(FeatureType.ACTION, (1,))},
+        )
+        return make_bc_rnn_pre_post_processors(config, own)
+
+    obs = {"observation.environment_state": torch.tensor([[0.03, 0.835]])}  # a 3 cm height error
+    own_input = processors(None)[0](obs)["observation.environment_state"][0]
+    assert float(own_input[1]) < -20  # amplified by its own tiny std
+    pre, post = processors(base)
+    d_input = pre(obs)["observation.environment_state"][0]
+    assert float(d_input[0]) == pytest.approx((0.03 - 0.01) / 0.02, rel=1e-4)
+    assert float(d_input[1]) == pytest.approx(-0.03, rel=1e-3)  # D never varied it: kept in metres
+    assert float(post(torch.tensor([[1.0]]))[0, 0]) == pytest.approx(0.5, rel=1e-5)  # own action range
+    with pytest.raises(ConfigError, match=r"policy.observation_stats=.*holds no meta/stats.json"):
+        processors(tmp_path / "nowhere")
+    elsewhere = {"observation.state": d_stats["observation.environment_state"]}
+    (base / "meta" / "stats.json").write_text(json.dumps(elsewhere))
+    with pytest.raises(ConfigError, match=r"has no mean/std for \['observation.environment_state'\]"):
+        processors(base)

@@ -18,7 +18,7 @@ import pytest
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.paper import VARIANTS
 from igen_lerobot.datasets.reader import load_episodes
-from igen_lerobot.experiments.config_table import TableConfig
+from igen_lerobot.experiments.config_table import TableConfig, TableTrainConfig
 from igen_lerobot.experiments.provenance import code_version, provenance_problems
 from igen_lerobot.experiments.table_steps import LABELS
 from igen_lerobot.training.config_train import TrainConfig
@@ -67,6 +67,11 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path, tiny_table)
     assert trainings and all(c.startswith("OMP_NUM_THREADS=2 lerobot-train ") for c in trainings)
     assert report["config"]["train"]["threads"] == 2
     assert "OMP_NUM_THREADS=2 lerobot-train --policy.type=bc_rnn" in markdown
+    # every row's inputs are normalised with D's statistics; Base's own are D's, so it is not told
+    normaliser = f"--policy.observation_stats={out / 'data' / 'base'}"
+    for step in (c for c in report["commands"] if c["step"].startswith("train_")):
+        assert (normaliser in step["command"]) == (not step["step"].startswith("train_base_")), step
+    assert report["config"]["observation_stats"] == "base" and "with the base dataset D's statistics" in markdown
     # every step's CPU time is recorded beside its wall time: a step runs code, so it costs CPU, and
     # a step cannot use more CPU seconds than the machine's cores give it in its wall time
     assert set(report["step_cpu_s"]) == set(report["step_times_s"]) == set(report["step_code"])
@@ -257,6 +262,31 @@ def test_a_table_recorded_before_a_setting_existed_resumes_with_its_default(tmp_
     # a nested key recorded before it existed (train.threads) is the count those tables trained with, 2
     with pytest.raises(ConfigError, match="other settings"):
         check_resumed_config(TableConfig(output_dir=str(out), variants=["base"], train=TrainConfig(threads=1)))
+
+
+def test_a_table_made_before_the_shared_normaliser_resumes_only_with_each_rows_own(tmp_path):
+    """A table_config.json without observation_stats was made with each row's own statistics: resuming
+    it under D's would mix two normalisers in one table, so it is refused; "own" resumes it."""
+    from igen_lerobot.experiments.table import check_resumed_config
+    from igen_lerobot.experiments.table_report import render_markdown
+
+    out = tmp_path / "t"
+    check_resumed_config(TableConfig(output_dir=str(out), variants=["base"], observation_stats="own"))
+    recorded = json.loads((out / "table_config.json").read_text())
+    del recorded["observation_stats"]
+    (out / "table_config.json").write_text(json.dumps(recorded))
+    with pytest.raises(ConfigError, match="observation_stats: own -> base"):
+        check_resumed_config(TableConfig(output_dir=str(out), variants=["base"]))
+    check_resumed_config(TableConfig(output_dir=str(out), variants=["base"], observation_stats="own"))
+    with pytest.raises(ConfigError, match=r"--observation_stats must be one of \['base', 'own'\]"):
+        TableConfig(observation_stats="mine")
+    with pytest.raises(ConfigError, match="--train.policy_type=act lacks; pass --observation_stats=own"):
+        TableConfig(train=TableTrainConfig(policy_type="act"))
+    # the published page says which normaliser a table used (one without the key: each row's own)
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    published = json.loads((docs / "results" / "block_grasp.json").read_text())
+    assert "observation_stats" not in published["config"]
+    assert "each row's own training data's statistics" in "\n".join(render_markdown(published))
 
 
 def test_a_table_fixes_its_training_threads_and_a_bad_count_is_refused():

@@ -87,3 +87,25 @@ def test_the_key_is_the_data_and_the_command_not_the_paths_or_provenance(tmp_pat
     assert key(changed, tmp_path / "c" / "train" / "base" / "seed7") != same
     assert key(a, tmp_path / "a" / "train" / "base" / "seed7", steps=6000) != same
     assert key(a, tmp_path / "a" / "train" / "base" / "seed7", threads="2") != same
+
+
+def test_a_normalising_dataset_counts_by_its_statistics_not_its_folder(tmp_path):
+    """Two tables' base datasets D hold the same statistics in different folders: a row normalised with
+    either trains the same weights (so the partial table can take the full table's MG Demo); other
+    statistics, or none, are another training."""
+    stats = {"observation.state": {"mean": [0.5], "std": [0.1]}}
+    data = _dataset(tmp_path / "data" / "train_mg_demo", b"rows", stats, {})
+    full_d = _dataset(tmp_path / "full" / "data" / "base", b"d", stats, {"reveal": "full"})
+    partial_d = _dataset(tmp_path / "partial" / "data" / "base", b"d", dict(reversed(stats.items())), {})
+    wider = {"observation.state": {"mean": [0.5], "std": [0.2]}}
+    other_d = _dataset(tmp_path / "other" / "data" / "base", b"d", wider, {})
+    out = tmp_path / "train" / "mg_demo" / "seed7"
+
+    def key(*normaliser: Path) -> str:
+        command = ["/venv/bin/lerobot-train", f"--dataset.root={data}", f"--output_dir={out}"]
+        command += [f"--policy.observation_stats={root}" for root in normaliser]
+        return training_key(command, {}, data, out)
+
+    assert key(full_d) == key(partial_d)
+    assert key(full_d) != key(other_d)
+    assert key(full_d) != key()

@@ -18,6 +18,10 @@ TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 # config fields added after tables were published that change no number (where records are kept,
 # whether weights are made again): a published config without them is still whole
 NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings")
+# config fields added after tables were published that do change numbers, with the value every table
+# made before them had: a config without one was made that way (and resumes only that way)
+EARLIER_VALUES = {"observation_stats": "own"}
+OBSERVATION_STATS = ("base", "own")
 
 # torch threads of every table's trainings unless --train.threads says otherwise: fixed, so that a machine
 # with more cores trains the same weights; 2, what every earlier table trained with (torch's default on
@@ -68,6 +72,11 @@ class TableConfig:
     # Quote each flag: --randomize='["--env.randomize.kp_scale=[0.5,1.5]","--env.randomize.latency=[0,0.04]"]'
     randomize: list[str] = field(default_factory=list)
     train: TableTrainConfig = field(default_factory=TableTrainConfig)
+    # whose statistics normalise every row's inputs: "base", the base dataset D's (BC-RNN's
+    # --policy.observation_stats; Base's own are D's), so that rows differ only in their data; "own", each
+    # row's training data's (LeRobot's default, and every table before this field). With its own, a row whose
+    # few added episodes are the only frames where an input varies gets that input amplified tens of times
+    observation_stats: str = "base"
     train_seeds: list[int] | None = None  # default: train.seed and the two after it; given, its first is train.seed
     eval_every: int = 1  # validate every k-th saved checkpoint (the last always), test the best
     n_val_trials: int = 50
@@ -123,6 +132,15 @@ class TableConfig:
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
         self.check_randomize()
+        if self.observation_stats not in OBSERVATION_STATS:
+            raise ConfigError(
+                f"--observation_stats must be one of {list(OBSERVATION_STATS)}, got {self.observation_stats!r}"
+            )
+        if self.observation_stats == "base" and self.train.policy_type != "bc_rnn":
+            raise ConfigError(
+                f"--observation_stats=base sets BC-RNN's --policy.observation_stats, which "
+                f"--train.policy_type={self.train.policy_type} lacks; pass --observation_stats=own"
+            )
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")
 

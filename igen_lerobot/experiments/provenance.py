@@ -85,7 +85,7 @@ def provenance_problems(result: dict) -> list[str]:
     the table's full config, so that the commands and the commit regenerate the numbers.
     """
     from igen_lerobot.experiments.config_rehearsal import RehearsalConfig
-    from igen_lerobot.experiments.config_table import NUMBER_NEUTRAL_FIELDS, TableConfig
+    from igen_lerobot.experiments.config_table import EARLIER_VALUES, NUMBER_NEUTRAL_FIELDS, TableConfig
     from igen_lerobot.experiments.rehearsal_report import is_rehearsal
 
     config_class = RehearsalConfig if is_rehearsal(result) else TableConfig
@@ -104,7 +104,7 @@ def provenance_problems(result: dict) -> list[str]:
             problems.append(f"step {step}: made with uncommitted changes at {made_by['commit'][:10]}")
     config = result.get("config")
     fields = set(config_class.__dataclass_fields__)
-    optional = set(NUMBER_NEUTRAL_FIELDS) if config_class is TableConfig else set()
+    optional = {*NUMBER_NEUTRAL_FIELDS, *EARLIER_VALUES} if config_class is TableConfig else set()
     if not isinstance(config, dict) or not (fields - optional <= set(config) <= fields):
         given = set(config) if isinstance(config, dict) else set()
         missing, unknown = sorted(fields - optional - given), sorted(given - fields)

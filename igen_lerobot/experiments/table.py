@@ -39,7 +39,7 @@ from igen_lerobot.core.exceptions import ConfigError, IgenError
 from igen_lerobot.core.paper import safe_name
 from igen_lerobot.evaluation.checkpoints import best_result
 from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
-from igen_lerobot.experiments.config_table import TableConfig
+from igen_lerobot.experiments.config_table import EARLIER_VALUES, TableConfig
 from igen_lerobot.experiments.ledger import REUSED_FILE, Ledger
 from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
@@ -365,7 +365,7 @@ def check_resumed_config(cfg: TableConfig) -> None:
         for f in fields(TableConfig)
         if f.default is not MISSING or f.default_factory is not MISSING
     }
-    recorded = {**defaults, **recorded}
+    recorded = {**defaults, **EARLIER_VALUES, **recorded}
     # and keys added inside nested configs: their value in a table made now (train.threads: 2, the count
     # every earlier table trained with, torch's default on the 2-core machine they ran on)
     current = _as_recorded(TableConfig())
@@ -514,7 +514,7 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     trained again unless ``weights_needed`` (the base policy that generation runs) or the table is
     asked to (``--retrain_restored``).
     """
-    cfg = replace(run.cfg.train, seed=seed, extra_args=list(run.cfg.train.extra_args))
+    cfg = replace(run.cfg.train, seed=seed, extra_args=[*run.cfg.train.extra_args, *normaliser_args(run, variant)])
     out = train_dir(run, variant, seed)
     final = final_checkpoint(out, cfg.steps)
     done = final / "config.json"
@@ -536,6 +536,13 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
         # marked for a sibling table that would train the same (also a training finished before keys were)
         write_key(out, key or training_key(command, env, dataset, out), source)
     return final
+
+
+def normaliser_args(run: TableRun, variant: str) -> list[str]:
+    """``--policy.observation_stats`` giving a row D's input statistics (none for Base: its own are D's)."""
+    if run.cfg.observation_stats != "base" or variant == "base":
+        return []
+    return [f"--policy.observation_stats={run.data('base')}"]
 
 
 def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: int, seed: int) -> dict:

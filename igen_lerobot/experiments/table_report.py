@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from igen_lerobot.core.paper import VARIANTS
+from igen_lerobot.experiments.config_table import EARLIER_VALUES
 from igen_lerobot.experiments.provenance import provenance_lines
 from igen_lerobot.experiments.rehearsal_report import is_rehearsal, render_rehearsal
 
@@ -142,6 +143,16 @@ def render_main_table(results: list[dict]) -> list[str]:
     return [*lines, ""]
 
 
+def _normaliser_line(cfg: dict) -> str:
+    """Whose statistics normalised the rows' inputs (tables before the choice: each row's own)."""
+    if cfg.get("observation_stats", EARLIER_VALUES["observation_stats"]) == "base":
+        return (
+            "- Inputs normalised (mean/std) with the base dataset D's statistics in every row "
+            "(`--policy.observation_stats=<D>`; Base's own are D's), so rows differ only in their data."
+        )
+    return "- Inputs normalised (mean/std) with each row's own training data's statistics (LeRobot's default)."
+
+
 def render_markdown(result: dict, notes: str = "") -> list[str]:
     """One table's section: the table, a reading of it, the protocol and the commands."""
     cfg = result["config"]
@@ -164,6 +175,7 @@ def render_markdown(result: dict, notes: str = "") -> list[str]:
         f"checkpoint every {train['save_freq'] or train['steps']} steps, device {train['device']}, "
         f"training seeds {', '.join(map(str, cfg['train_seeds']))} (the first one's base policy collects "
         "and generates the interventions).",
+        _normaliser_line(cfg),
         f"- Checkpoint choice: {_which_checkpoints(cfg['eval_every'])} on {cfg['n_val_trials']} validation "
         f"trials from seed {cfg['val_seed']}; the rate reported is that checkpoint's on {cfg['n_trials']} "
         f"test trials from seed {cfg['test_seed']}. 95% CI: Wilson, on all seeds' test trials together.",

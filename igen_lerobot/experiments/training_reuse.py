@@ -23,6 +23,7 @@ from igen_lerobot.training.lerobot_train import final_checkpoint
 
 KEY_FILE = "training_key.json"
 STATS_FILE = "meta/stats.json"
+OBSERVATION_STATS_FLAG = "--policy.observation_stats="
 # where a link is being made: a stopped link leaves this, never a checkpoints/ that looks whole
 PARTIAL_CHECKPOINTS = "checkpoints.partial"
 
@@ -46,15 +47,31 @@ def dataset_digest(root: Path) -> str:
     return digest.hexdigest()
 
 
+def stats_digest(root: Path) -> str:
+    """A digest of the statistics recorded in the dataset at ``root``, read as numbers."""
+    stats = json.loads((Path(root) / STATS_FILE).read_text())
+    return hashlib.sha256(json.dumps(stats, sort_keys=True).encode()).hexdigest()
+
+
 def training_key(command: list[str], env: dict[str, str], dataset: Path, output_dir: Path) -> str:
-    """What decides a training's weights: its command without this run's paths, its env and its data."""
+    """What decides a training's weights: its command without this run's paths, its env and its data.
+
+    A dataset whose statistics normalise the inputs (``--policy.observation_stats``) counts by its
+    statistics, not its path: two tables' base datasets D hold the same numbers in different folders.
+    """
     swaps = [(str(output_dir), "<output_dir>"), (str(dataset), "<dataset>"), (f"local/{dataset.name}", "<repo_id>")]
     args = [Path(command[0]).name]
+    normalisers = []
     for arg in command[1:]:
+        if arg.startswith(OBSERVATION_STATS_FLAG):
+            normalisers.append(stats_digest(Path(arg.removeprefix(OBSERVATION_STATS_FLAG))))
+            arg = f"{OBSERVATION_STATS_FLAG}<stats>"
         for path, placeholder in swaps:
             arg = arg.replace(path, placeholder)
         args.append(arg)
     what = {"command": args, "env": dict(sorted(env.items())), "data": dataset_digest(dataset)}
+    if normalisers:
+        what["observation_stats"] = normalisers
     return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()
 
 

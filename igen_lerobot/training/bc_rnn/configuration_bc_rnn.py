@@ -52,6 +52,12 @@ class BCRNNConfig(PreTrainedConfig):
     # at the first step (docs/results.md, "Why the base policy lets go"); a no-op where no input is
     # constant (Block Grasp).
     constant_input_std: float = 1.0
+    # a dataset root whose observation statistics normalise the inputs instead of the training data's own
+    # (the actions keep the training data's). igen-table gives every row the base dataset D's, so rows
+    # differ only in their data: with its own, a row whose few added episodes are the only frames where
+    # an input varies (a peg's height under error) gets a tiny std from them, and that input's deviations
+    # reach the network as tens of standard deviations (docs/results.md, "One normaliser for every row")
+    observation_stats: str | None = None
     optimizer_lr: float = 1e-3
     optimizer_weight_decay: float = 0.0
     optimizer_grad_clip_norm: float = 1e6  # robomimic does not clip gradients

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 from typing import Any
 
 import torch
 from lerobot.configs.types import NormalizationMode
 from lerobot.processor import PolicyAction, PolicyProcessorPipeline, make_default_pre_post_processors
 
+from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
 
 logger = logging.getLogger(__name__)
@@ -32,8 +34,9 @@ def make_bc_rnn_pre_post_processors(
 def input_stats(
     config: BCRNNConfig, stats: dict[str, dict[str, torch.Tensor]] | None
 ) -> dict[str, dict[str, torch.Tensor]] | None:
-    """``stats`` as BC-RNN normalises with them (the constant-input std, then the tolerance).
+    """``stats`` as BC-RNN normalises with them (another dataset's, the constant-input std, the tolerance).
 
+    With ``config.observation_stats`` the mean/std-normalised inputs take that dataset's statistics.
     A mean/std-normalised input that never varies in the data gets ``config.constant_input_std``;
     then every such input's std gets ``config.obs_std_tolerance`` added.
     """
@@ -44,6 +47,8 @@ def input_stats(
         for key, feature in config.input_features.items()
         if config.normalization_mapping.get(feature.type.value) is NormalizationMode.MEAN_STD
     }
+    if config.observation_stats is not None:
+        stats = {**stats, **observation_stats_of(Path(config.observation_stats), normalised & set(stats))}
     if config.obs_std_tolerance == 0 and config.constant_input_std == 0:
         warn_constant_inputs(stats, normalised)
         return stats
@@ -54,6 +59,25 @@ def input_stats(
             std = torch.where(std < CONSTANT_STD, torch.full_like(std, config.constant_input_std), std)
         out[key] = {**stats[key], "std": std + config.obs_std_tolerance}
     return out
+
+
+def observation_stats_of(root: Path, keys: set[str]) -> dict[str, dict[str, torch.Tensor]]:
+    """The statistics of ``keys`` recorded in the dataset at ``root`` (``policy.observation_stats``)."""
+    from lerobot.datasets.io_utils import load_stats
+
+    stats = load_stats(root) if root.is_dir() else None
+    if stats is None:
+        raise ConfigError(
+            f"policy.observation_stats={root} holds no meta/stats.json; give the root of a LeRobot dataset "
+            "of the same task (igen-table passes its base dataset D)"
+        )
+    missing = sorted(key for key in keys if key not in stats or "std" not in stats[key])
+    if missing:
+        raise ConfigError(
+            f"policy.observation_stats={root} has no mean/std for {missing}; give a dataset with the same "
+            "observation features as the training data"
+        )
+    return {key: {name: torch.as_tensor(value) for name, value in stats[key].items()} for key in keys}
 
 
 def warn_constant_inputs(stats: dict[str, dict[str, torch.Tensor]], keys: set[str]) -> list[str]:
