@@ -44,6 +44,10 @@ def test_two_iterations_grow_the_dataset_and_resume_without_redoing(source_demos
         assert generated["policy"] == it["policy"] and generated["mode"] == "igen"
         sizes.append(len(load_episodes(it["dataset"], SPEC)))
     assert sizes == [base + 2, base + 4]  # D grows by n generated interventions per iteration
+    # every policy reads its inputs with the base dataset's statistics: the first trains on it, the
+    # later ones on D + generated are given it (--observation_stats=base, the default)
+    given = [json.loads((Path(it["policy"]) / "config.json").read_text()) for it in produced["iterations"]]
+    assert given[0]["observation_stats"] is None and given[1]["observation_stats"] == str(source_demos)
 
     stamp = (Path(produced["iterations"][0]["policy"]) / "model.safetensors").stat().st_mtime
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)

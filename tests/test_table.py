@@ -18,6 +18,7 @@ import pytest
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.paper import VARIANTS
 from igen_lerobot.datasets.reader import load_episodes
+from igen_lerobot.experiments.config_loop import LoopConfig
 from igen_lerobot.experiments.config_table import TableConfig, TableTrainConfig
 from igen_lerobot.experiments.provenance import code_version, provenance_problems
 from igen_lerobot.experiments.table_steps import LABELS
@@ -282,6 +283,9 @@ def test_a_table_made_before_the_shared_normaliser_resumes_only_with_each_rows_o
         TableConfig(observation_stats="mine")
     with pytest.raises(ConfigError, match="--train.policy_type=act lacks; pass --observation_stats=own"):
         TableConfig(train=TableTrainConfig(policy_type="act"))
+    with pytest.raises(ConfigError, match="--train.policy_type=act lacks"):
+        LoopConfig(base_dataset="d", train=TrainConfig(policy_type="act"))
+    assert LoopConfig(base_dataset="d", train=TrainConfig(policy_type="act"), observation_stats="own")
     # the published page says which normaliser a table used (one without the key: each row's own)
     docs = Path(__file__).resolve().parents[1] / "docs"
     published = json.loads((docs / "results" / "block_grasp.json").read_text())

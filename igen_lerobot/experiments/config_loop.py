@@ -9,6 +9,7 @@ from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.datasets.config_dataset import DatasetOutputConfig
 from igen_lerobot.generation.intervengen import IntervenGenConfig
 from igen_lerobot.training.config_train import TrainConfig
+from igen_lerobot.training.normaliser import check_observation_stats
 
 
 @dataclass
@@ -26,6 +27,9 @@ class LoopConfig:
     train: TrainConfig = field(default_factory=TrainConfig)
     igen: IntervenGenConfig = field(default_factory=IntervenGenConfig)
     train_final: bool = True  # also train the policy on the final D
+    # whose statistics normalise the inputs of the trainings on D + generated: "base", the base dataset's
+    # (as the first policy's), or "own", each training set's (LeRobot's default); see training/normaliser.py
+    observation_stats: str = "base"
     output_dir: str = "outputs/loop"
     # --dataset.push_to_hub=true --dataset.repo_id=user/name pushes the final D (it lives under output_dir)
     dataset: DatasetOutputConfig = field(default_factory=DatasetOutputConfig)
@@ -34,6 +38,7 @@ class LoopConfig:
         task_config_class(self.task)  # a clear error for an unknown task, before any work
         if self.base_dataset is None:
             raise ConfigError("--base_dataset is required: the dataset D the first policy is trained on")
+        check_observation_stats(self.observation_stats, self.train.policy_type)
         for name in ("iterations", "interventions", "generated", "workers"):
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")

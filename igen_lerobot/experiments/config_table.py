@@ -10,6 +10,7 @@ from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.paper import VARIANTS, PaperTable, is_variant
 from igen_lerobot.evaluation.config_eval import EVAL_SEED
 from igen_lerobot.training.config_train import TrainConfig
+from igen_lerobot.training.normaliser import check_observation_stats
 
 VAL_SEED = EVAL_SEED  # the trials earlier tables reported on: they choose checkpoints now
 TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
@@ -21,7 +22,6 @@ NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings")
 # config fields added after tables were published that do change numbers, with the value every table
 # made before them had: a config without one was made that way (and resumes only that way)
 EARLIER_VALUES = {"observation_stats": "own"}
-OBSERVATION_STATS = ("base", "own")
 
 # torch threads of every table's trainings unless --train.threads says otherwise: fixed, so that a machine
 # with more cores trains the same weights; 2, what every earlier table trained with (torch's default on
@@ -132,15 +132,7 @@ class TableConfig:
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
         self.check_randomize()
-        if self.observation_stats not in OBSERVATION_STATS:
-            raise ConfigError(
-                f"--observation_stats must be one of {list(OBSERVATION_STATS)}, got {self.observation_stats!r}"
-            )
-        if self.observation_stats == "base" and self.train.policy_type != "bc_rnn":
-            raise ConfigError(
-                f"--observation_stats=base sets BC-RNN's --policy.observation_stats, which "
-                f"--train.policy_type={self.train.policy_type} lacks; pass --observation_stats=own"
-            )
+        check_observation_stats(self.observation_stats, self.train.policy_type)
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")
 

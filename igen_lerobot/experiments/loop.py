@@ -28,6 +28,7 @@ from igen_lerobot.experiments.config_loop import LoopConfig
 from igen_lerobot.generation.config_generate import GenerateConfig, SourceDatasetConfig
 from igen_lerobot.generation.generate import generate
 from igen_lerobot.training.lerobot_train import lerobot_train
+from igen_lerobot.training.normaliser import observation_stats_args
 from igen_lerobot.training.policy_source import PolicySourceConfig
 
 logger = logging.getLogger(__name__)
@@ -37,6 +38,13 @@ def _complete(root: Path) -> bool:
     return (root / "meta" / "igen.json").exists()
 
 
+def _train(cfg: LoopConfig, dataset: Path, output_dir: Path) -> Path:
+    """``lerobot-train`` on ``dataset``, its inputs normalised as ``cfg.observation_stats`` says."""
+    normaliser = observation_stats_args(cfg.observation_stats, Path(cfg.base_dataset), dataset)
+    train = dataclasses.replace(cfg.train, extra_args=[*cfg.train.extra_args, *normaliser])
+    return lerobot_train(train, dataset, f"local/{dataset.name}", output_dir)
+
+
 def run_loop(cfg: LoopConfig) -> dict:
     """Run (or resume) ``cfg.iterations`` iterations; returns the paths it produced."""
     out = Path(cfg.output_dir)
@@ -44,7 +52,7 @@ def run_loop(cfg: LoopConfig) -> dict:
     produced: dict = {"iterations": []}
     for i in range(cfg.iterations):
         step_dir = out / f"iter_{i}"
-        checkpoint = lerobot_train(cfg.train, dataset, f"local/{dataset.name}", step_dir / "train")
+        checkpoint = _train(cfg, dataset, step_dir / "train")
         policy = PolicySourceConfig(path=str(checkpoint), device=cfg.train.device)
         interventions = step_dir / "interventions"
         if not _complete(interventions):
@@ -89,7 +97,7 @@ def run_loop(cfg: LoopConfig) -> dict:
         dataset = merged
     produced["dataset"] = str(dataset)
     if cfg.train_final:
-        produced["policy"] = str(lerobot_train(cfg.train, dataset, f"local/{dataset.name}", out / "final_train"))
+        produced["policy"] = str(_train(cfg, dataset, out / "final_train"))
     return produced
 
 

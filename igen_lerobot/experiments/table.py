@@ -69,6 +69,7 @@ from igen_lerobot.training.lerobot_train import (
     train_command,
     train_env,
 )
+from igen_lerobot.training.normaliser import observation_stats_args
 
 logger = logging.getLogger(__name__)
 
@@ -514,7 +515,8 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     trained again unless ``weights_needed`` (the base policy that generation runs) or the table is
     asked to (``--retrain_restored``).
     """
-    cfg = replace(run.cfg.train, seed=seed, extra_args=[*run.cfg.train.extra_args, *normaliser_args(run, variant)])
+    normaliser = observation_stats_args(run.cfg.observation_stats, run.data("base"), dataset)
+    cfg = replace(run.cfg.train, seed=seed, extra_args=[*run.cfg.train.extra_args, *normaliser])
     out = train_dir(run, variant, seed)
     final = final_checkpoint(out, cfg.steps)
     done = final / "config.json"
@@ -536,13 +538,6 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
         # marked for a sibling table that would train the same (also a training finished before keys were)
         write_key(out, key or training_key(command, env, dataset, out), source)
     return final
-
-
-def normaliser_args(run: TableRun, variant: str) -> list[str]:
-    """``--policy.observation_stats`` giving a row D's input statistics (none for Base: its own are D's)."""
-    if run.cfg.observation_stats != "base" or variant == "base":
-        return []
-    return [f"--policy.observation_stats={run.data('base')}"]
 
 
 def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: int, seed: int) -> dict:
