@@ -38,7 +38,9 @@
 #
 # Every row of a table trains the same way: its budget (the in-hand tasks and Nut-and-Peg train 5000
 # steps, Block Grasp the paper's 2000, Block Grasp on randomised arms 6000), its thread count (Block
-# Grasp 2, made before the lanes; every later table 1) plus PROTOCOL, the settings every table shares.
+# Grasp 2, made before the lanes; every later table 1), its input normaliser (Block Grasp each row's own
+# statistics, made before the choice; every later table D's, igen-table's default) plus PROTOCOL, the
+# settings every table shares.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=${OUT_ROOT:-outputs/tables}
@@ -51,7 +53,7 @@ REHEARSALS=(block_grasp_randomized_rehearsal)
 # the paper's five sim-to-real rows: the only ones the rehearsal runs, so the only ones this table trains
 SIM_TO_REAL_ROWS='[base,source_int,mg_demo,igen_no_policy,igen]'
 declare -A TABLES=(
-  [block_grasp]="--task=block_grasp --train.threads=2"
+  [block_grasp]="--task=block_grasp --train.threads=2 --observation_stats=own"
   [nut_insertion]="--task=nut_insertion ${long[*]}"
   [nut_insertion_contact_position]="--task=nut_insertion --reveal=contact_position ${long[*]}"
   [two_piece_assembly]="--task=two_piece_assembly ${long[*]}"

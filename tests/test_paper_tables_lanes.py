@@ -61,3 +61,37 @@ def test_a_rehearsal_is_skipped_while_another_lane_runs_a_table(tmp_path):
     assert rehearsal.returncode == 0 and "runs alone, and another lane is running; skipped" in output
     assert table.wait(timeout=60) == 0
     assert "start igen-rehearse" not in log.read_text()
+
+
+def test_each_published_table_is_what_its_paper_tables_command_makes(tmp_path):
+    """A fresh run of the script's command for a published table must make that table: every setting that
+    changes numbers (sizes, seeds, training, normaliser) equals the one recorded in its JSON, as a resume
+    of it would demand (igen-table's own check)."""
+    import json
+    import shlex
+
+    import draccus
+
+    from igen_lerobot.experiments.config_table import TableConfig
+    from igen_lerobot.experiments.table import check_resumed_config
+
+    bin_dir, args = tmp_path / "bin", tmp_path / "args"
+    bin_dir.mkdir()
+    published = sorted((SCRIPT.parents[1] / "docs" / "results").glob("*.json"))
+    assert published, "no published table to check"
+    for path in published:
+        name, result = path.stem, json.loads(path.read_text())
+        if "config" not in result or "task" not in result["config"]:
+            continue  # a rehearsal's page, not a table
+        args.mkdir(exist_ok=True)
+        stand_in = f'#!/usr/bin/env bash\nprintf "%q " "$@" > "{args / name}"\n'
+        (bin_dir / "igen-table").write_text(stand_in)
+        (bin_dir / "igen-table").chmod(0o755)
+        env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": name, "DRY_RUN": "true"}
+        subprocess.run(["bash", str(SCRIPT), name], env=env, check=True, capture_output=True, timeout=60)
+        flags = [f for f in shlex.split((args / name).read_text()) if not f.startswith(("--output_dir", "--dry_run"))]
+        out = tmp_path / "resume" / name
+        out.mkdir(parents=True)
+        (out / "table_config.json").write_text(json.dumps(result["config"]))
+        cfg = draccus.parse(TableConfig, args=[*flags, f"--output_dir={out}"])
+        check_resumed_config(cfg)  # raises, naming the setting, where a fresh run would differ
