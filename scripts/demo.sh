@@ -35,9 +35,11 @@ cat <<MSG
 
 demo: done. The IntervenGen dataset (MimicGen demos + generated interventions) is
   $out/loop/iter_0/dataset
-Train on it and evaluate under the paper's pose error:
+Train on it (inputs normalised with D's statistics, as igen-table does) and evaluate under the
+paper's pose error:
   $bin/lerobot-train --policy.type=bc_rnn --policy.device=cpu --policy.push_to_hub=false \\
-      --dataset.repo_id=local/dataset --dataset.root=$out/loop/iter_0/dataset --output_dir=outputs/train/igen
+      --dataset.repo_id=local/dataset --dataset.root=$out/loop/iter_0/dataset --output_dir=outputs/train/igen \\
+      --policy.observation_stats=$out/mg_demos
   MUJOCO_GL=egl $bin/lerobot-eval --env.type=block_grasp --policy.path=outputs/train/igen/checkpoints/last/pretrained_model \\
       --policy.device=cpu --eval.n_episodes=50 --eval.batch_size=1 --output_dir=outputs/eval/igen
 MSG
