@@ -40,17 +40,19 @@ def dataset_digest(root: Path) -> str:
         relative = path.relative_to(root).as_posix()
         if relative == IGEN_META_FILE:
             continue
-        data = path.read_bytes()
-        if relative == STATS_FILE:
-            data = json.dumps(json.loads(data), sort_keys=True).encode()
+        data = _canonical_stats(path) if relative == STATS_FILE else path.read_bytes()
         digest.update(relative.encode() + b"\0" + hashlib.sha256(data).digest())
     return digest.hexdigest()
 
 
+def _canonical_stats(path: Path) -> bytes:
+    """A ``stats.json`` as numbers, whatever its key order."""
+    return json.dumps(json.loads(path.read_bytes()), sort_keys=True).encode()
+
+
 def stats_digest(root: Path) -> str:
     """A digest of the statistics recorded in the dataset at ``root``, read as numbers."""
-    stats = json.loads((Path(root) / STATS_FILE).read_text())
-    return hashlib.sha256(json.dumps(stats, sort_keys=True).encode()).hexdigest()
+    return hashlib.sha256(_canonical_stats(Path(root) / STATS_FILE)).hexdigest()
 
 
 def training_key(command: list[str], env: dict[str, str], dataset: Path, output_dir: Path) -> str:
