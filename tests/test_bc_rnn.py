@@ -115,6 +115,59 @@ def test_a_batch_of_trials_steps_each_row_as_alone_where_the_rnn_allows(rnn_type
     assert exact == (rnn_type == "LSTM")
 
 
+def _small_policy(hidden: int = 24):
+    from lerobot.configs import FeatureType, PolicyFeature
+
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.modeling_bc_rnn import BCRNNPolicy
+
+    torch.manual_seed(0)
+    config = BCRNNConfig(
+        rnn_hidden_dim=hidden,
+        horizon=4,
+        input_features={"observation.state": PolicyFeature(FeatureType.STATE, (5,))},
+        output_features={"action": PolicyFeature(FeatureType.ACTION, (3,))},
+    )
+    return BCRNNPolicy(config)
+
+
+def test_amp_runs_the_lstm_in_bfloat16_and_the_mixture_in_float32():
+    """``--policy.use_amp`` (LeRobot's accelerate autocast, bfloat16 on CPU) speeds up the LSTM; the
+    mixture's likelihood with scales down to 1e-4 stays float32. Tolerance: the bfloat16 loss is
+    within 5% of the float32 loss on the same weights."""
+    policy = _small_policy()
+    batch = {"observation.state": torch.randn(8, 4, 5), "action": torch.rand(8, 4, 3) * 2 - 1}
+    seen = {}
+    policy.rnn.register_forward_hook(lambda module, args, out: seen.__setitem__("rnn", out[0].dtype))
+    policy.head.register_forward_hook(lambda module, args, out: seen.__setitem__("head", out.mean.dtype))
+    full, _ = policy.forward(batch)
+    assert seen == {"rnn": torch.float32, "head": torch.float32}
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        mixed, _ = policy.forward(batch)
+    assert seen == {"rnn": torch.bfloat16, "head": torch.float32}
+    assert mixed.dtype == torch.float32
+    assert abs(mixed.item() - full.item()) <= 0.05 * abs(full.item())
+    mixed.backward()
+    assert all(p.grad is not None and p.grad.dtype == torch.float32 for p in policy.parameters())
+
+
+def test_acting_is_float32_even_under_autocast():
+    """lerobot-eval autocasts ``select_action`` when the policy was trained with use_amp; the actions
+    must still be the float32 ones that igen-eval and a grouped evaluation take (tolerance 0)."""
+    policy = _small_policy()
+    inputs = torch.randn(6, 2, 5)
+    actions = {}
+    for autocast in (False, True):
+        policy.reset()
+        torch.manual_seed(7)
+        with torch.autocast("cpu", dtype=torch.bfloat16, enabled=autocast):
+            actions[autocast] = torch.stack([policy.select_action({"observation.state": inputs[t]}) for t in range(6)])
+            grouped = policy.select_action_per_trial({"observation.state": inputs[0]}, [torch.Generator()] * 2)
+        assert grouped.dtype == torch.float32
+    assert actions[True].dtype == torch.float32
+    assert torch.equal(actions[True], actions[False])
+
+
 def test_lerobot_train_checkpoint_loads_and_acts_in_our_env(bc_rnn_checkpoint, block_grasp_env, source_demos):
     from igen_lerobot.training.checkpoint_policy import LeRobotCheckpointPolicy
 

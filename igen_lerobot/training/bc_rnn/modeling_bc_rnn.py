@@ -4,9 +4,16 @@ Training sees sequences of ``horizon`` steps (LeRobot delta timestamps) and maxi
 log-likelihood of the recorded actions under the mixture, ignoring padded steps past an
 episode's end. At rollout the policy carries its RNN state from step to step and resets it
 every ``horizon`` steps and at every episode start.
+
+LeRobot's ``--policy.use_amp`` trains under autocast (bfloat16 on CPU): BC-RNN then runs only its
+LSTM in bfloat16 and keeps its mixture in float32, and it always acts in float32, so ``igen-eval``
+and ``lerobot-eval`` (which autocasts when the flag is set) give the same actions. The tables do not
+use it: about 1.35x less CPU a step, but a policy that learnt less (docs/benchmarks.md).
 """
 
 from __future__ import annotations
+
+import functools
 
 import torch
 from lerobot.policies.pretrained import PreTrainedPolicy
@@ -17,6 +24,22 @@ from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
 
 ACTION = "action"
 LOW_NOISE_STD = 1e-4
+
+
+def _float32(device_type: str) -> torch.autocast:
+    """A block with autocast off: the head's likelihood, and acting."""
+    return torch.autocast(device_type, enabled=False)
+
+
+def _acts_in_float32(method):
+    """Run an acting method with autocast off on the policy's device."""
+
+    @functools.wraps(method)
+    def acting(self, *args, **kwargs):
+        with _float32(torch.device(self.config.device or "cpu").type):
+            return method(self, *args, **kwargs)
+
+    return acting
 
 
 class GMMHead(nn.Module):
@@ -96,8 +119,14 @@ class BCRNNPolicy(PreTrainedPolicy):
         return torch.cat([batch[k] for k in self.input_keys], dim=-1)
 
     def _distribution(self, inputs: Tensor, hidden=None, low_noise: bool = False):
+        """The action mixture after the RNN; the RNN alone follows an active autocast (``--policy.use_amp``).
+
+        The head and its likelihood stay in float32: a mixture of scales down to ``gmm_min_std``
+        (1e-4) cannot be evaluated in bfloat16's 8 bits of mantissa.
+        """
         out, hidden = self.rnn(inputs, hidden)
-        return self.head(self.mlp(out), low_noise=low_noise), hidden
+        with _float32(out.device.type):
+            return self.head(self.mlp(out.float()), low_noise=low_noise), hidden
 
     def forward(self, batch: dict[str, Tensor]) -> tuple[Tensor, dict]:
         inputs = self._inputs(batch)  # (B, T, D) from LeRobot's delta timestamps
@@ -118,6 +147,7 @@ class BCRNNPolicy(PreTrainedPolicy):
         return self.select_action(batch).unsqueeze(1)
 
     @torch.no_grad()
+    @_acts_in_float32
     def select_action(self, batch: dict[str, Tensor]) -> Tensor:
         self.eval()
         if self._steps % self.config.horizon == 0:
@@ -137,6 +167,7 @@ class BCRNNPolicy(PreTrainedPolicy):
         return self.config.rnn_type == "LSTM" and self.config.device in (None, "cpu")
 
     @torch.no_grad()
+    @_acts_in_float32
     def select_action_per_trial(self, batch: dict[str, Tensor], generators: list[torch.Generator]) -> Tensor:
         """:meth:`select_action` for B trials stepped together, row ``k`` drawing from ``generators[k]``.
 
