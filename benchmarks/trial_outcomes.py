@@ -1,0 +1,104 @@
+"""How each trial of an in-hand task's evaluation report ended: what a failed policy did instead.
+
+Every trial of the report is run again with the report's policy, task, reveal mode and seed (the
+policy seeded per trial, as ``igen-eval`` does), its frames recorded, and its end classified:
+
+* ``success``: in and released;
+* ``let go before contact``: the fingers opened before the held part first touched the target
+  (a policy releasing at the seat of the target it observes, an error away);
+* ``no contact, holding``: the part never touched the target and is still held at the end (the
+  policy hovered or wandered);
+* ``contact, let go off the seat``: it touched (revealing what the reveal mode reveals), then the
+  fingers opened without a success;
+* ``contact, holding``: it touched and was still held at the end (did not find the way in).
+
+A rerun trial must end as the report says: a mismatch is printed and counted, so a table's reading
+never rests on trials that did not replay.
+
+Run:  .venv/bin/python benchmarks/trial_outcomes.py REPORT.json [REPORT.json ...] [--trials 50]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+from lerobot.utils.import_utils import register_third_party_plugins
+
+from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.core.recorder import EpisodeRecorder
+from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.evaluation.trials import rollout
+from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
+
+OUTCOMES = (
+    "success",
+    "let go before contact",
+    "no contact, holding",
+    "contact, let go off the seat",
+    "contact, holding",
+)
+
+
+def classify(success: bool, width: np.ndarray, contact: np.ndarray, holding_width: float) -> str:
+    """One trial's outcome from its per-frame finger opening and contact flag (see the module doc)."""
+    if success:
+        return OUTCOMES[0]
+    released = np.flatnonzero(width > holding_width)
+    touched = np.flatnonzero(contact)
+    first_release = int(released[0]) if released.size else None
+    first_contact = int(touched[0]) if touched.size else None
+    if first_contact is None:
+        return OUTCOMES[1] if first_release is not None else OUTCOMES[2]
+    if first_release is not None and first_release < first_contact:
+        return OUTCOMES[1]
+    return OUTCOMES[3] if first_release is not None else OUTCOMES[4]
+
+
+def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
+    report = json.loads(report_path.read_text())
+    result = report["best"] if "best" in report else report["results"][0]
+    config = task_config_class(report["task"])(reveal=report["reveal"])
+    geometry = config.geometry
+    spec = config.task_spec
+    names = list(spec.env_state_names)
+    contact_col = names.index("contact")
+    env = config.make_task_env()
+    policy = make_base_policy(PolicySourceConfig(path=result["policy"]), config)
+    counts, mismatches = Counter(), []
+    trials = report["n_trials"] if max_trials is None else min(max_trials, report["n_trials"])
+    try:
+        for i in range(trials):
+            recorder = EpisodeRecorder(env)
+            success, _ = rollout(env, policy, episode_seed(report["seed"], i), config.episode_length, recorder)
+            if success != result["per_trial"][i]:
+                mismatches.append(i)
+            episode = recorder.episode(kind="eval", seed=episode_seed(report["seed"], i), success=success)
+            width = episode.state[:, spec.state_names.index("gripper.width")]
+            counts[classify(success, width, episode.env_state[:, contact_col] > 0.5, geometry.holding_width)] += 1
+    finally:
+        env.close()
+    return {
+        "report": str(report_path),
+        "policy": result["policy"],
+        "trials": trials,
+        "outcomes": {name: counts[name] for name in OUTCOMES},
+        "trials_not_replayed": mismatches,
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("reports", nargs="+", type=Path)
+    parser.add_argument("--trials", type=int, default=None, help="only the first N trials of each report")
+    args = parser.parse_args()
+    register_third_party_plugins()
+    for path in args.reports:
+        print(json.dumps(trial_outcomes(path, args.trials)))
+
+
+if __name__ == "__main__":
+    main()
