@@ -12,6 +12,9 @@ policy seeded per trial, as ``igen-eval`` does), its frames recorded, and its en
   fingers opened without a success;
 * ``contact, holding``: it touched and was still held at the end (did not find the way in).
 
+Beside the counts, each outcome's median final offset of the held part from the target's axis
+(table plane, true poses) and of its bottom above the seat, in mm: where the failures ended.
+
 A rerun trial must end as the report says: a mismatch is printed and counted, so a table's reading
 never rests on trials that did not replay.
 
@@ -58,6 +61,17 @@ def classify(success: bool, width: np.ndarray, contact: np.ndarray, holding_widt
     return OUTCOMES[3] if first_release is not None else OUTCOMES[4]
 
 
+def final_offsets(env, geometry) -> tuple[float, float]:
+    """The held part's distance from the target's axis in the table plane, and its bottom above the seat [m]."""
+    poses = env.true_object_poses()
+    held, target = poses[geometry.held][:3, 3], poses[geometry.target][:3, 3]
+    return float(np.linalg.norm(held[:2] - target[:2])), float(held[2] - geometry.held_bottom - geometry.seat_z)
+
+
+def _median_mm(ends: list[tuple[float, float]], k: int) -> float:
+    return round(1000 * float(np.median([e[k] for e in ends])), 1)
+
+
 def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
     report = json.loads(report_path.read_text())
     result = report["best"] if "best" in report else report["results"][0]
@@ -69,6 +83,7 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
     env = config.make_task_env()
     policy = make_base_policy(PolicySourceConfig(path=result["policy"]), config)
     counts, mismatches = Counter(), []
+    ends: dict[str, list[tuple[float, float]]] = {name: [] for name in OUTCOMES}
     trials = report["n_trials"] if max_trials is None else min(max_trials, report["n_trials"])
     try:
         for i in range(trials):
@@ -78,7 +93,9 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
                 mismatches.append(i)
             episode = recorder.episode(kind="eval", seed=episode_seed(report["seed"], i), success=success)
             width = episode.state[:, spec.state_names.index("gripper.width")]
-            counts[classify(success, width, episode.env_state[:, contact_col] > 0.5, geometry.holding_width)] += 1
+            outcome = classify(success, width, episode.env_state[:, contact_col] > 0.5, geometry.holding_width)
+            counts[outcome] += 1
+            ends[outcome].append(final_offsets(env, geometry))
     finally:
         env.close()
     return {
@@ -86,6 +103,8 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
         "policy": result["policy"],
         "trials": trials,
         "outcomes": {name: counts[name] for name in OUTCOMES},
+        "median_final_off_axis_mm": {n: _median_mm(e, 0) for n, e in ends.items() if e},
+        "median_final_above_seat_mm": {n: _median_mm(e, 1) for n, e in ends.items() if e},
         "trials_not_replayed": mismatches,
     }
 
