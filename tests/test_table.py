@@ -183,6 +183,18 @@ def test_every_step_records_the_machine_it_ran_on_and_the_page_says_when_they_di
     assert machine_line(older) == "- Machine: not recorded (the steps ran before machines were)."
 
 
+def test_the_code_line_counts_steps_per_commit():
+    from igen_lerobot.experiments.provenance import code_line
+
+    a, b = {"commit": "a" * 40}, {"commit": "b" * 40}
+    assert code_line({"step_code": {"base": a, "eval": a}}) == f"- Code: every step ran at commit {'a' * 10}."
+    line = code_line({"step_code": {"base": a, "eval": a, "test": b, "old": None}})
+    assert line == (
+        f"- Code: steps ran at 3 versions ({'a' * 10}: 2 steps; {'b' * 10}: 1 step; unrecorded: 1 step; "
+        "per step in the JSON)."
+    )
+
+
 def test_superseded_tables_render_with_their_curves():
     from igen_lerobot.experiments.table_report import load_superseded, render_page
 

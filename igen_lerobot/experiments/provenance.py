@@ -142,7 +142,9 @@ def code_line(result: dict) -> str:
         by_commit.setdefault(key, []).append(step)
     if len(by_commit) == 1:
         return f"- Code: every step ran at commit {next(iter(by_commit))}."
-    parts = "; ".join(f"{commit}: {len(steps)} steps" for commit, steps in sorted(by_commit.items()))
+    parts = "; ".join(
+        f"{commit}: {len(steps)} step{'' if len(steps) == 1 else 's'}" for commit, steps in sorted(by_commit.items())
+    )
     return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
 
 
