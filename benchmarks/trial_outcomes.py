@@ -28,6 +28,7 @@ import json
 from collections import Counter
 from pathlib import Path
 
+import draccus
 import numpy as np
 from lerobot.utils.import_utils import register_third_party_plugins
 
@@ -76,7 +77,15 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
     report = json.loads(report_path.read_text())
     result = report["best"] if "best" in report else report["results"][0]
     config = task_config_class(report["task"])(reveal=report["reveal"])
-    geometry = config.geometry
+    geometry = getattr(config, "geometry", None)
+    if geometry is None:
+        raise SystemExit(f"{report_path}: {report['task']} is not an in-hand insertion task (no held part to follow)")
+    recorded = {k: v for k, v in report["corruption"].items() if k != "type"}  # the choice's name
+    if draccus.encode(config.corruption) != recorded:
+        raise SystemExit(
+            f"{report_path}: error model {report['corruption']} is not the task's default "
+            f"{draccus.encode(config.corruption)}; this script reruns trials under the default one"
+        )
     spec = config.task_spec
     names = list(spec.env_state_names)
     contact_col = names.index("contact")
