@@ -15,22 +15,15 @@ import argparse
 import json
 from pathlib import Path
 
-import draccus
 from lerobot.utils.import_utils import register_third_party_plugins
 
-from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.evaluation.evaluate import report_env_config
 
 
 def errors_of(report: dict) -> list[float]:
     """Each trial's sampled pose error (one row per trial), from the report's task, error model and seed."""
-    config = task_config_class(report["task"])()
-    recorded = {k: v for k, v in report["corruption"].items() if k != "type"}  # the choice's name
-    if draccus.encode(config.corruption) != recorded:
-        raise SystemExit(
-            f"report error model {report['corruption']} is not the task's default {draccus.encode(config.corruption)}: "
-            "this script samples the default one"
-        )
+    config = report_env_config(report)
     env = config.make_task_env()
     try:
         rows = []

@@ -28,13 +28,12 @@ import json
 from collections import Counter
 from pathlib import Path
 
-import draccus
 import numpy as np
 from lerobot.utils.import_utils import register_third_party_plugins
 
-from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.recorder import EpisodeRecorder
 from igen_lerobot.core.seeding import episode_seed
+from igen_lerobot.evaluation.evaluate import report_env_config
 from igen_lerobot.evaluation.trials import rollout
 from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
 
@@ -76,16 +75,10 @@ def _median_mm(ends: list[tuple[float, float]], k: int) -> float:
 def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
     report = json.loads(report_path.read_text())
     result = report["best"] if "best" in report else report["results"][0]
-    config = task_config_class(report["task"])(reveal=report["reveal"])
+    config = report_env_config(report)
     geometry = getattr(config, "geometry", None)
     if geometry is None:
         raise SystemExit(f"{report_path}: {report['task']} is not an in-hand insertion task (no held part to follow)")
-    recorded = {k: v for k, v in report["corruption"].items() if k != "type"}  # the choice's name
-    if draccus.encode(config.corruption) != recorded:
-        raise SystemExit(
-            f"{report_path}: error model {report['corruption']} is not the task's default "
-            f"{draccus.encode(config.corruption)}; this script reruns trials under the default one"
-        )
     spec = config.task_spec
     names = list(spec.env_state_names)
     contact_col = names.index("contact")

@@ -88,6 +88,19 @@ def test_igen_eval_evaluates_a_lerobot_train_run(bc_rnn_checkpoint, tmp_path):
     assert "step 3:" in result.stdout and "95% CI" in result.stdout
 
 
+def test_a_report_gives_back_the_config_its_trials_ran_under(block_grasp_config):
+    from igen_lerobot.evaluation.evaluate import error_model_record, report_env_config
+
+    record = error_model_record(block_grasp_config.corruption)
+    report = {"task": "block_grasp", "reveal": "full", "corruption": record}
+    config = report_env_config(report)
+    assert config.type == "block_grasp" and str(config.reveal) == "full"
+    assert error_model_record(config.corruption) == json.loads(json.dumps(record))
+    other = {**record, next(k for k in record if k != "type"): "changed"}
+    with pytest.raises(ConfigError, match="corruption .* default error model"):
+        report_env_config({**report, "corruption": other})
+
+
 def test_igen_eval_bad_input_names_the_fix(tmp_path):
     run = subprocess.run(
         [str(BIN / "igen-eval"), "--task=block_grasp", f"--train_dir={tmp_path}"],

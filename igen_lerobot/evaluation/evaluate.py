@@ -7,6 +7,8 @@ import json
 import logging
 from pathlib import Path
 
+from igen_lerobot.core.env_config import TaskEnvConfig, task_config_class
+from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.evaluation.checkpoints import best_result, list_checkpoints
 from igen_lerobot.evaluation.config_eval import EvalConfig
 from igen_lerobot.evaluation.parallel import TrialPool
@@ -26,6 +28,26 @@ def _line(result: EvalResult) -> str:
     )
 
 
+def error_model_record(corruption) -> dict:
+    """How a report records its error model: the choice's name, then its fields, as JSON reads them back."""
+    return json.loads(json.dumps({"type": corruption.type_name, **dataclasses.asdict(corruption)}))
+
+
+def report_env_config(report: dict) -> TaskEnvConfig:
+    """The task config a report's trials ran under (its task and reveal mode), for rerunning them.
+
+    Trials are rerun from their seeds alone, so they replay only under the error model the report
+    records; a report made under another one than the task's default is refused.
+    """
+    config = task_config_class(report["task"])(reveal=report["reveal"])
+    if error_model_record(config.corruption) != report["corruption"]:
+        raise ConfigError(
+            f"report corruption {report['corruption']} is not {report['task']}'s default error model "
+            f"{error_model_record(config.corruption)}: its trials cannot be rerun from their seeds here"
+        )
+    return config
+
+
 def run_eval(cfg: EvalConfig) -> dict:
     """Evaluate one policy or a run's checkpoints; print and return (and optionally save) the results."""
     env_cfg = cfg.env
@@ -43,10 +65,7 @@ def run_eval(cfg: EvalConfig) -> dict:
         "task": env_cfg.type,
         "n_trials": cfg.n_trials,
         "seed": cfg.seed,
-        "corruption": {
-            "type": env_cfg.corruption.type_name,
-            **dataclasses.asdict(env_cfg.corruption),
-        },
+        "corruption": error_model_record(env_cfg.corruption),
         "reveal": str(env_cfg.reveal),
         "results": [r.to_json() for r in results],
         "best": best.to_json(),

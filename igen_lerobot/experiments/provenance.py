@@ -130,6 +130,10 @@ def keep_assembly_record(result: dict, recorded: Path, executed: list[str]) -> N
         result["code"], result["wall_time_s"] = previous["code"], previous["wall_time_s"]
 
 
+def _steps(n: int) -> str:
+    return f"{n} step{'' if n == 1 else 's'}"
+
+
 def code_line(result: dict) -> str:
     """Which commits made the table's steps: one, or each with the steps it made."""
     by_commit: dict[str, list[str]] = {}
@@ -142,9 +146,7 @@ def code_line(result: dict) -> str:
         by_commit.setdefault(key, []).append(step)
     if len(by_commit) == 1:
         return f"- Code: every step ran at commit {next(iter(by_commit))}."
-    parts = "; ".join(
-        f"{commit}: {len(steps)} step{'' if len(steps) == 1 else 's'}" for commit, steps in sorted(by_commit.items())
-    )
+    parts = "; ".join(f"{commit}: {_steps(len(steps))}" for commit, steps in sorted(by_commit.items()))
     return f"- Code: steps ran at {len(by_commit)} versions ({parts}; per step in the JSON)."
 
 
@@ -158,7 +160,7 @@ def machine_line(result: dict) -> str:
         return "- Machine: not recorded (the steps ran before machines were)."
     if len(by_machine) == 1:
         return f"- Machine: every step ran on {next(iter(by_machine))}."
-    parts = "; ".join(f"{machine}: {n} step{'' if n == 1 else 's'}" for machine, n in sorted(by_machine.items()))
+    parts = "; ".join(f"{machine}: {_steps(n)}" for machine, n in sorted(by_machine.items()))
     return f"- Machine: steps ran on {len(by_machine)} machines ({parts}; per step in the JSON)."
 
 
