@@ -26,8 +26,12 @@ def _column(root: Path, key: str) -> np.ndarray:
     return np.concatenate([np.stack(part.to_numpy(zero_copy_only=False)) for part in parts])
 
 
-def reveal_stats(root: Path, obj: str) -> dict:
-    """Frames and episodes that observe ``obj`` revealed, and the observation's error in metres."""
+def reveal_stats(root: Path, obj: str, held: str | None = None) -> dict:
+    """Frames and episodes that observe ``obj`` revealed, and the observation's error in metres.
+
+    With ``held``, also how far that part is from ``obj``'s axis (true poses, table plane) on each
+    episode's first frame: for generated interventions, which store ``xi[t:]``, the mistake state.
+    """
     features = json.loads((root / "meta" / "info.json").read_text())["features"]
     observed_names, true_names = features[OBSERVED]["names"], features[TRUE]["names"]
     if "revealed" not in observed_names:
@@ -46,6 +50,18 @@ def reveal_stats(root: Path, obj: str) -> dict:
     def median(values: np.ndarray) -> float | None:
         return float(np.median(values)) if len(values) else None
 
+    first_frame = {}
+    if held is not None:
+        frame = _column(root, "frame_index").reshape(-1) == 0
+        xy = [true_names.index(f"{name}.{axis}") for name in (held, obj) for axis in "xy"]
+        off_axis = np.linalg.norm(true[frame][:, xy[:2]] - true[frame][:, xy[2:]], axis=1)
+        first_frame = {
+            "held_off_axis_first_frame_m": {
+                "median": float(np.median(off_axis)),
+                "p10": float(np.percentile(off_axis, 10)),
+                "p90": float(np.percentile(off_axis, 90)),
+            }
+        }
     return {
         "episodes": int(len(episodes)),
         "frames": int(len(episode)),
@@ -54,6 +70,7 @@ def reveal_stats(root: Path, obj: str) -> dict:
         "plane_error_revealed_m": median(plane[revealed]),
         "plane_error_unrevealed_m": median(plane[~revealed]),
         "height_offset_revealed_m": median(offset[revealed, 2]),
+        **first_frame,
     }
 
 
@@ -61,9 +78,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("roots", nargs="+", type=Path, help="LeRobot dataset folders")
     parser.add_argument("--object", default="peg", help="the revealed object's name in the task's features")
+    parser.add_argument("--held", default=None, help="a held part: its offset from the object's axis on first frames")
     args = parser.parse_args()
     for root in args.roots:
-        print(json.dumps({"dataset": str(root), **reveal_stats(root, args.object)}))
+        print(json.dumps({"dataset": str(root), **reveal_stats(root, args.object, args.held)}))
 
 
 if __name__ == "__main__":
