@@ -143,3 +143,20 @@ def test_rotation_conversions_give_scipys_exact_numbers(seed):
         assert np.array_equal(matrix_from_rotvec(rotvec), Rotation.from_rotvec(rotvec).as_matrix())
     # a list is taken as the public API takes it
     assert np.array_equal(matrix_from_rotvec([0.1, 0.2, 0.3]), Rotation.from_rotvec([0.1, 0.2, 0.3]).as_matrix())
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_matrices_off_orthonormal_get_scipys_projection(seed):
+    """The validation scipy runs is skipped only where it changes nothing: matrices off a rotation
+    by more than rounding (noise from 1e-15 up to 1e-9, across scipy's 1e-12 tolerance) still
+    give scipy's exact numbers, and a left-handed one is still refused."""
+    rng = np.random.default_rng(seed)
+    for scale in (1e-15, 1e-13, 3e-13, 1e-12, 3e-12, 1e-9):
+        for rot in random_rotation_stack(rng, 100):
+            noisy = rot + rng.normal(scale=scale, size=(3, 3))
+            assert np.array_equal(rotvec_from_matrix(noisy), Rotation.from_matrix(noisy).as_rotvec()), scale
+            pose = np.eye(4)
+            pose[:3, :3] = noisy
+            assert np.array_equal(pose_to_pos_quat(pose)[1], Rotation.from_matrix(noisy).as_quat()), scale
+    with pytest.raises(ValueError, match="determinant"):
+        rotvec_from_matrix(np.diag([1.0, 1.0, -1.0]))

@@ -67,9 +67,36 @@ def pose_to_pos_quat(pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     rot = pose[..., :3, :3]
     if _compiled_rotations is None or rot.ndim > 3:
         return pose[..., :3, 3].copy(), Rotation.from_matrix(rot).as_quat()
-    quat = _compiled_rotations.from_matrix(rot, assume_valid=False)
+    quat = _quats_from_matrices(rot)
     quat = _compiled_rotations.as_quat(np.atleast_2d(quat), canonical=False, scalar_first=False)
     return pose[..., :3, 3].copy(), quat[0] if rot.ndim == 2 else quat
+
+
+def _quats_from_matrices(rot: np.ndarray) -> np.ndarray:
+    """The quaternions of scipy's ``from_matrix``, skipping its validation where it cannot change a bit of the result.
+
+    Unless told the input is valid, scipy checks every matrix (determinant, Gram matrix against
+    the identity with ``atol=1e-12``) and projects the ones off by more onto the nearest rotation;
+    those checks cost four times the conversion. A single matrix that is orthonormal to rounding
+    (Gram matrix off the identity by <= 1e-13, ten times inside scipy's tolerance, so the two
+    sums' rounding cannot disagree) and right-handed is converted as valid: scipy would not
+    have touched it. Anything else, stacks included, takes scipy's full path.
+    """
+    if rot.ndim == 2 and _orthonormal_to_rounding(rot):
+        return _compiled_rotations.from_matrix(rot, assume_valid=True)
+    return _compiled_rotations.from_matrix(rot, assume_valid=False)
+
+
+def _orthonormal_to_rounding(rot: np.ndarray) -> bool:
+    m0, m1, m2, m3, m4, m5, m6, m7, m8 = rot.reshape(9).tolist()
+    gram_diagonal = (m0 * m0 + m1 * m1 + m2 * m2, m3 * m3 + m4 * m4 + m5 * m5, m6 * m6 + m7 * m7 + m8 * m8)
+    gram_off_diagonal = (m0 * m3 + m1 * m4 + m2 * m5, m0 * m6 + m1 * m7 + m2 * m8, m3 * m6 + m4 * m7 + m5 * m8)
+    det = m0 * (m4 * m8 - m5 * m7) - m1 * (m3 * m8 - m5 * m6) + m2 * (m3 * m7 - m4 * m6)
+    return (
+        det > 0
+        and all(abs(g - 1.0) <= 1e-6 for g in gram_diagonal)  # scipy's rtol gives the diagonal 1e-5
+        and all(abs(g) <= 1e-13 for g in gram_off_diagonal)
+    )
 
 
 def pos_quat_to_pose(pos: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
@@ -179,7 +206,7 @@ def rotvec_from_matrix(rot: np.ndarray) -> np.ndarray:
     rot = np.asarray(rot, dtype=float)
     if _compiled_rotations is None or rot.ndim != 2:
         return Rotation.from_matrix(rot).as_rotvec()
-    quat = _compiled_rotations.from_matrix(rot, assume_valid=False)
+    quat = _quats_from_matrices(rot)
     return _compiled_rotations.as_rotvec(quat[None], degrees=False)[0]
 
 
