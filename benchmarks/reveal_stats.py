@@ -39,6 +39,8 @@ def reveal_stats(root: Path, obj: str, held: str | None = None) -> dict:
     xyz = [f"{obj}.{axis}" for axis in "xyz"]
     if not set(xyz) <= set(observed_names):
         raise SystemExit(f"{root}: no object {obj!r} in {OBSERVED}; --object is one of its '<object>.x' names")
+    if held is not None and not {f"{held}.x", f"{held}.y"} <= set(true_names):
+        raise SystemExit(f"{root}: no part {held!r} in {TRUE}; --held is one of its '<part>.x' names")
     observed, true = _column(root, OBSERVED), _column(root, TRUE)
     episode = _column(root, "episode_index").reshape(-1)
     revealed = observed[:, observed_names.index("revealed")] > 0.5
