@@ -70,8 +70,8 @@ def trace(task: str, flags: list[str], path: Path) -> None:
     from igen_lerobot.core.belief import Reveal
     from igen_lerobot.core.env_config import task_config_class
 
-    reveal = Reveal.CONTACT_POSITION if flags else Reveal.FULL
-    cfg = task_config_class(task)(reveal=reveal)
+    # the task's own reveal mode unless the name asks for another (Nut-and-Peg reveals nothing)
+    cfg = task_config_class(task)(reveal=Reveal.CONTACT_POSITION) if flags else task_config_class(task)()
     env, operator, policy = cfg.make_task_env(), cfg.make_scripted_operator(), cfg.make_scripted_policy()
     # the static description and the config as a dataset records it (parsed: key order is not compared)
     arrays: dict[str, np.ndarray] = {"spec": np.array(repr(env.spec)), "config_spec": np.array(repr(cfg.task_spec))}
