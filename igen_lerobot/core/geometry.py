@@ -77,10 +77,11 @@ def _quats_from_matrices(rot: np.ndarray) -> np.ndarray:
 
     Unless told the input is valid, scipy checks every matrix (determinant, Gram matrix against
     the identity with ``atol=1e-12``) and projects the ones off by more onto the nearest rotation;
-    those checks cost four times the conversion. A single matrix that is orthonormal to rounding
-    (Gram matrix off the identity by <= 1e-13, ten times inside scipy's tolerance, so the two
-    sums' rounding cannot disagree) and right-handed is converted as valid: scipy would not
-    have touched it. Anything else, stacks included, takes scipy's full path.
+    those checks cost several times the conversion (benchmarks/rotation_check_cost.py). A single
+    matrix that is orthonormal to rounding (Gram matrix off the identity by <= 1e-13, ten times
+    inside scipy's tolerance, so the two sums' rounding cannot disagree) and right-handed is
+    converted as valid: scipy would not have touched it. Anything else, stacks included, takes
+    scipy's full path.
     """
     if rot.ndim == 2 and _orthonormal_to_rounding(rot):
         return _compiled_rotations.from_matrix(rot, assume_valid=True)
