@@ -440,7 +440,7 @@ def test_a_step_stopped_by_sigterm_records_its_leg_and_resumes(tmp_path):
     import threading
 
     from igen_lerobot.experiments.provenance import provenance_lines
-    from igen_lerobot.experiments.table import StepRunner
+    from igen_lerobot.experiments.step_runner import StepRunner
 
     runner = StepRunner(tmp_path)
     done = tmp_path / "done"
@@ -468,11 +468,11 @@ def test_a_step_stopped_by_sigterm_records_its_leg_and_resumes(tmp_path):
 
 def test_each_step_records_the_code_checked_out_when_it_started(tmp_path, monkeypatch):
     """A commit landed while a table runs is named by the steps started after it, not the earlier ones."""
-    from igen_lerobot.experiments import table
+    from igen_lerobot.experiments import step_runner
 
     checkouts = iter([{"commit": "a" * 40, "dirty": False}, {"commit": "b" * 40, "dirty": False}])
-    monkeypatch.setattr(table, "code_version", lambda: next(checkouts))
-    runner = table.StepRunner(tmp_path)  # the table's start: commit a
+    monkeypatch.setattr(step_runner, "code_version", lambda: next(checkouts))
+    runner = step_runner.StepRunner(tmp_path)  # the table's start: commit a
     runner.run("first", ["touch", str(tmp_path / "first")], tmp_path / "first")  # started at commit b
     assert runner.code["commit"] == "a" * 40
     assert json.loads((tmp_path / "step_commits.json").read_text())["first"]["commit"] == "b" * 40

@@ -7,8 +7,8 @@ import shutil
 import pytest
 
 from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.experiments.checkpoint_choice import chosen_checkpoint
 from igen_lerobot.experiments.ledger import STEP_RECORDS, Ledger
-from igen_lerobot.experiments.table import chosen_checkpoint
 
 
 def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data_policy(tmp_path, tiny_table):
@@ -93,3 +93,51 @@ def test_the_ledger_keeps_only_small_records_and_never_overwrites_a_local_one(tm
     assert json.loads((out / "eval" / "igen" / "seed1" / "validation.json").read_text()) == {"local": True}
     assert restored == []
     assert Ledger(None, out).restore(on_record=lambda step: True) == []
+
+
+def test_a_rehearsing_table_keeps_each_runs_rehearsal_and_trains_again_only_the_unrehearsed(tmp_path, tiny_table):
+    """--rehearse: each run is rehearsed as it is tested, its reports kept in the ledger, so on a new machine
+    only a run whose rehearsal is not on record (and the data policy) is trained again, and nothing is
+    rehearsed twice."""
+    out, ledger, results = tmp_path / "table", tmp_path / "ledger", tmp_path / "results.md"
+    flags = (
+        "--variants=[base]",
+        "--train_seeds=[7,8]",
+        f"--ledger_dir={ledger}",
+        "--rehearse=true",
+        "--rehearsal.trials=1",
+        "--rehearsal.max_steps=5",
+        "--rehearsal.paths=[eval,rendered]",
+    )
+    first = tiny_table(out, results, *flags)
+    assert first.returncode == 0, first.stderr[-4000:]
+    rehearsal = json.loads((tmp_path / "results" / "block_grasp_rehearsal.json").read_text())
+    steps = {f"rehearse_{path}_base_seed{seed}" for path in ("eval", "rendered") for seed in (7, 8)}
+    assert set(rehearsal["step_times_s"]) == steps == {c["step"] for c in rehearsal["commands"]}
+    assert [(r["variant"], r["path"], r["trials"]) for r in rehearsal["results"]] == [
+        ("base", "eval", 2),
+        ("base", "rendered", 2),
+    ]
+    kept = {p.relative_to(ledger).as_posix() for p in ledger.rglob("*.json")}
+    for seed in (7, 8):
+        assert {f"rehearsal/reports/base/seed{seed}/{path}.json" for path in ("eval", "rendered")} <= kept
+    assert "rehearsal/rehearsal_config.json" in kept
+
+    # the machine is lost after seed 8 was tested but before its rehearsal reached the ledger
+    shutil.rmtree(out)
+    (ledger / "rehearsal" / "reports" / "base" / "seed8" / "rendered.json").unlink()
+    again = tiny_table(out, results, *flags)
+    assert again.returncode == 0, again.stderr[-4000:]
+    logs = {p.name for p in (out / "logs").glob("*.log")}
+    # seed 8 is trained again for its weights, and only its missing path runs; its evaluation stands
+    assert {"train_base_seed8.log", "rehearse_rendered_base_seed8.log"} <= logs
+    assert not logs & {"validate_base_seed8.log", "test_base_seed8.log", "rehearse_eval_base_seed8.log"}
+    # seed 7 is trained again for the data it generates, but rehearsed no more: its reports are on record
+    assert not any(name.startswith("rehearse_") and "seed7" in name for name in logs)
+    resumed = json.loads((tmp_path / "results" / "block_grasp_rehearsal.json").read_text())
+    assert [(r["variant"], r["path"], r["trials"]) for r in resumed["results"]] == [
+        ("base", "eval", 2),
+        ("base", "rendered", 2),
+    ]
+    assert resumed["rows"][0]["results"]["eval"] == rehearsal["rows"][0]["results"]["eval"]
+    assert (ledger / "rehearsal" / "reports" / "base" / "seed8" / "rendered.json").exists()

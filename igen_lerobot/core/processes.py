@@ -1,10 +1,14 @@
-"""Worker processes: one compute thread each, and their CPU time counted where the parent's is."""
+"""Worker processes: one compute thread each, their CPU time counted where the parent's is, their priority."""
 
 from __future__ import annotations
 
 import contextlib
+import logging
 import multiprocessing.forkserver
 import os
+from collections.abc import Iterator
+
+logger = logging.getLogger(__name__)
 
 
 def limit_threads() -> None:
@@ -38,3 +42,31 @@ def reap_forkserver() -> None:
         return
     with contextlib.suppress(OSError, ChildProcessError):
         stop()
+
+
+@contextlib.contextmanager
+def normal_priority() -> Iterator[bool]:
+    """Run the block, and the processes it starts, at nice 0 when this process runs niced; yields whether it does.
+
+    A run paced on a clock (franky-sim's 1 kHz loop, the 20 Hz deployment loop) inside a long job
+    started at low priority (the table lanes run at nice 10) would otherwise share the cores as an equal
+    with whatever else runs niced. Not enough on its own: beside two niced trainings, franky at nice 0
+    still lost every trial to the watchdog (docs/benchmarks.md), so the lanes also pause each other
+    while franky runs. Raising a priority needs CAP_SYS_NICE: without it the block runs at the inherited
+    niceness, and says so in the log.
+    """
+    before = os.getpriority(os.PRIO_PROCESS, 0)
+    raised = False
+    if before > 0:
+        try:
+            os.setpriority(os.PRIO_PROCESS, 0, 0)
+            raised = True
+        except PermissionError:
+            logger.warning(
+                "cannot raise this process from nice %d to 0 (needs CAP_SYS_NICE); runs at %d", before, before
+            )
+    try:
+        yield raised or before <= 0
+    finally:
+        if raised:
+            os.setpriority(os.PRIO_PROCESS, 0, before)

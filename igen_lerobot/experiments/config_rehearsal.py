@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 from igen_lerobot.core.exceptions import ConfigError
 
+REHEARSED_TASK = "block_grasp"  # the only task the cameras perceive, and the paper's sim-to-real task
+
 # the paths a checkpoint is rehearsed on, in the order they run and are shown
 PATHS = {
     "eval": "igen-eval (MuJoCo, the training simulator)",

@@ -9,6 +9,7 @@ from igen_lerobot.core.env_config import TaskEnvConfig, task_config_class
 from igen_lerobot.core.exceptions import ConfigError
 from igen_lerobot.core.paper import VARIANTS, PaperTable, is_variant
 from igen_lerobot.evaluation.config_eval import EVAL_SEED
+from igen_lerobot.experiments.config_rehearsal import PATHS, REHEARSED_TASK, RehearsalConfig
 from igen_lerobot.training.config_train import TrainConfig
 from igen_lerobot.training.normaliser import check_observation_stats
 
@@ -18,7 +19,7 @@ TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 
 # config fields added after tables were published that change no number (where records are kept,
 # whether weights are made again): a published config without them is still whole
-NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings")
+NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings", "rehearse", "rehearsal")
 # config fields added after tables were published that do change numbers, with the value every table
 # made before them had: a config without one was made that way (and resumes only that way)
 EARLIER_VALUES = {"observation_stats": "own"}
@@ -39,6 +40,21 @@ class TableTrainConfig(TrainConfig):
 
     save_freq: int = 500
     threads: int | None = TABLE_TRAIN_THREADS
+
+
+@dataclass
+class TableRehearsalConfig:
+    """``--rehearsal.*``: what each run of a ``--rehearse=true`` table runs (igen-rehearse's flags and defaults)."""
+
+    trials: int = 20
+    max_steps: int = 200  # [steps at 20 Hz]
+    paths: list[str] = field(default_factory=lambda: list(PATHS))
+
+    def as_rehearsal(self, table_dir: str, **more) -> RehearsalConfig:
+        """igen-rehearse's config of a table in ``table_dir`` with these settings (checked there)."""
+        return RehearsalConfig(
+            table_dir=table_dir, trials=self.trials, max_steps=self.max_steps, paths=list(self.paths), **more
+        )
 
 
 @dataclass
@@ -89,8 +105,16 @@ class TableConfig:
     # no seed whose evaluation is on record ("": keep none). Datasets and checkpoints are not kept.
     ledger_dir: str = ""
     # train again the runs whose numbers were restored from the ledger, so that their checkpoints are on
-    # this machine (igen-rehearse reads them); training is deterministic, so the weights are those tested
+    # this machine (igen-rehearse reads them); training is deterministic on one machine, so the weights
+    # are those tested where the machine is the same (each step's record names its machine)
     retrain_restored: bool = False
+    # rehearse each run of the paper's sim-to-real rows as soon as it is tested: its chosen checkpoint
+    # through igen-rehearse's paths and defaults (igen-eval, the MuJoCo arm with a rendered D415, franky on
+    # franky-sim; 20 of the test trials), the reports kept in the ledger, so that a machine lost between
+    # sessions loses no rehearsal and a rehearsed run is never trained again; the table then writes its
+    # rehearsal's JSON too. Block Grasp's main table under full observability only.
+    rehearse: bool = False
+    rehearsal: TableRehearsalConfig = field(default_factory=TableRehearsalConfig)
     # take a training from another table in the same parent folder (full and partial observability,
     # the scaling table) when its data and command are the same: deterministic training would make the
     # same weights. Linked, recorded with its source's time and commit in step_reused.json; evaluated anew
@@ -132,6 +156,12 @@ class TableConfig:
             if getattr(self, name) < 1:
                 raise ConfigError(f"--{name} must be >= 1, got {getattr(self, name)}")
         self.check_randomize()
+        if self.rehearse and (self.task != REHEARSED_TASK or self.reveal not in (None, "full") or self.table):
+            raise ConfigError(
+                f"--rehearse=true rehearses --task={REHEARSED_TASK}'s main table under full observability "
+                f"(the paper's sim-to-real task), not --task={self.task} --reveal={self.reveal} --table={self.table}"
+            )
+        self.rehearsal.paths = self.rehearsal.as_rehearsal(".").paths  # checked, in the order they run
         check_observation_stats(self.observation_stats, self.train.policy_type)
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")

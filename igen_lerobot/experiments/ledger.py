@@ -28,9 +28,10 @@ STEP_RECORDS = (
     "step_interrupted_times.json",
     REUSED_FILE,
 )
-# the run's own settings, and the folder of its evaluation reports: what else the ledger keeps
+# the run's own settings, and the folders of its evaluation and rehearsal reports (JSON files in them):
+# what else the ledger keeps
 KEPT_FILES = ("table_config.json",)
-KEPT_FOLDERS = ("eval",)
+KEPT_FOLDERS = ("eval", "rehearsal")
 
 
 def _write_atomically(path: Path, text: str) -> None:

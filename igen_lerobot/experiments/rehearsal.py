@@ -28,17 +28,19 @@ from pathlib import Path
 
 from igen_lerobot.core.env_config import task_config_class
 from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.core.processes import normal_priority
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import wilson_interval
-from igen_lerobot.experiments.config_rehearsal import PATHS, RehearsalConfig
+from igen_lerobot.experiments.checkpoint_choice import chosen_checkpoint
+from igen_lerobot.experiments.config_rehearsal import PATHS, REHEARSED_TASK, RehearsalConfig
 from igen_lerobot.experiments.rehearsal_report import KIND, ordering
-from igen_lerobot.experiments.table import StepFailedError, StepRunner, chosen_checkpoint
+from igen_lerobot.experiments.step_runner import StepFailedError, StepRunner
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import variant_label
 
 logger = logging.getLogger(__name__)
 
-TASK = "block_grasp"  # the only task the cameras perceive, and the paper's sim-to-real task
+TASK = REHEARSED_TASK
 # settings whose change would mix two protocols in one rehearsal (the rows and paths may grow)
 FIXED = ("table_dir", "seeds", "trial_seed", "trials", "max_steps", "device")
 
@@ -170,58 +172,83 @@ def pooled_result(per_seed: dict[int, dict], chosen_steps: dict[int, int]) -> di
     }
 
 
-def run_rehearsal(cfg: RehearsalConfig) -> dict:
-    """Run every (row, path) not yet done; write the rehearsal's JSON and re-render the results page."""
-    start = time.perf_counter()
-    table_dir = Path(cfg.table_dir)
-    table = read_table_config(table_dir)
-    paper = task_config_class(TASK)().paper_table()
-    rows = cfg.rows or [r for r in paper.rows if r in paper.real]
-    settings = resolved_settings(cfg, table)
-    out = Path(cfg.output_dir) if cfg.output_dir else table_dir / "rehearsal"
-    check_resumed(out, settings)
-    runner = StepRunner(out, cfg.in_process)
-    seeds = settings["seeds"]
-    chosen = {(row, seed): chosen_checkpoint(table_dir, row, seed) for row in rows for seed in seeds}
+def rehearsal_name(table: dict) -> str:
+    """The rehearsal's name in the results folder: a table generated on randomised arms is rehearsed under its own."""
+    return f"{TASK}_randomized_rehearsal" if table.get("randomize") else f"{TASK}_rehearsal"
+
+
+def report_path(out: Path, row: str, seed: int, path: str) -> Path:
+    """Where one (row, training seed, path) report is kept: ``<out>/reports/<row>/seed<k>/<path>.json``."""
+    return Path(out) / "reports" / row / f"seed{seed}" / f"{path}.json"
+
+
+def run_paths(
+    runner: StepRunner,
+    cfg: RehearsalConfig,
+    settings: dict,
+    out: Path,
+    runs: list[tuple[str, int]],
+    step_prefix: str = "",
+) -> None:
+    """Each path on each (row, training seed) of ``runs`` whose report is not on record, path by path.
+
+    Only a pending step reads its checkpoint, so runs whose reports a ledger restored need no weights
+    here. franky-sim is started once for the pending franky steps, and it and they run at normal
+    priority (:func:`normal_priority`): they are paced in real time, beside a niced table's neighbours.
+    """
+    table_dir = Path(settings["table_dir"])
+
+    def run_each(path: str) -> None:
+        for row, seed in runs:
+            report = report_path(out, row, seed, path)
+            # a step on record is only recorded: its checkpoint is named, not read
+            checkpoint = chosen_checkpoint(table_dir, row, seed, on_this_machine=not report.exists())[1]
+            command = path_command(runner, path, checkpoint, settings, report, cfg)
+            run_step(runner, f"{step_prefix}{path}_{row}_seed{seed}", command, report)
+
+    for path in cfg.paths:
+        pending = any(not report_path(out, row, seed, path).exists() for row, seed in runs)
+        if path != "franky" or not pending:
+            run_each(path)
+            continue
+        from lerobot_robot_igen.arm.franky_sim_server import running  # the hardware extra, needed here only
+
+        log = out / "logs" / "franky_sim.log"
+        with normal_priority(), running(cfg.franky_host, scene_port=cfg.franky_scene_port, log=log):
+            run_each(path)
+
+
+def checkpoint_choice_text(table: dict, seeds: list[int]) -> str:
+    """How the rehearsed checkpoints were chosen, as the page says it."""
     which = "of the table" if seeds == table["train_seeds"] else "given by --seeds"
-    choice = (
+    return (
         f"the one igen-table chose (best on its {table['n_val_trials']} validation trials) for each training seed "
         f"{which} ({', '.join(map(str, seeds))}); a cell pools their trials"
     )
-    trial_choice = (
-        f"the table's test trials (seed {settings['trial_seed']}), which no checkpoint choice saw"
-        if settings["trial_seed"] == table["test_seed"]
-        else f"trials from seed {settings['trial_seed']} (--trial_seed; the table's test seed is {table['test_seed']})"
-    )
-    print(f"checkpoints: per row, {choice}; trials: {settings['trials']} of {trial_choice}")
 
-    def report_of(row: str, seed: int, path: str) -> Path:
-        return out / "reports" / row / f"seed{seed}" / f"{path}.json"
 
-    def run_path(path: str) -> None:
-        for row in rows:
-            for seed in seeds:
-                report = report_of(row, seed, path)
-                command = path_command(runner, path, chosen[row, seed][1], settings, report, cfg)
-                run_step(runner, f"{path}_{row}_seed{seed}", command, report)
+def trial_choice_text(table: dict, settings: dict) -> str:
+    """Which trials every path ran, as the page says it."""
+    if settings["trial_seed"] == table["test_seed"]:
+        return f"the table's test trials (seed {settings['trial_seed']}), which no checkpoint choice saw"
+    return f"trials from seed {settings['trial_seed']} (--trial_seed; the table's test seed is {table['test_seed']})"
 
-    for path in cfg.paths:
-        pending = any(not report_of(row, seed, path).exists() for row in rows for seed in seeds)
-        if path == "franky" and pending:
-            from lerobot_robot_igen.arm.franky_sim_server import running  # the hardware extra, needed here only
 
-            log = out / "logs" / "franky_sim.log"
-            with running(cfg.franky_host, scene_port=cfg.franky_scene_port, log=log):
-                run_path(path)
-        else:
-            run_path(path)
-
+def write_rehearsal(
+    cfg: RehearsalConfig, table: dict, settings: dict, out: Path, rows: list[str], record: dict
+) -> dict:
+    """Pool every (row, seed, path) report into the rehearsal's JSON, write it and re-render the results page."""
+    table_dir, seeds = Path(settings["table_dir"]), settings["seeds"]
+    paper = task_config_class(TASK)().paper_table()
+    chosen = {
+        (row, seed): chosen_checkpoint(table_dir, row, seed, on_this_machine=False) for row in rows for seed in seeds
+    }
     result_rows = []
     for row in rows:
         steps = {seed: chosen[row, seed][0] for seed in seeds}
         results = {
             p: pooled_result(
-                {seed: seed_result(p, json.loads(report_of(row, seed, p).read_text())) for seed in seeds}, steps
+                {seed: seed_result(p, json.loads(report_path(out, row, seed, p).read_text())) for seed in seeds}, steps
             )
             for p in cfg.paths
         }
@@ -236,8 +263,7 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
                 "results": results,
             }
         )
-    randomize = table.get("randomize") or []  # a table generated on randomised arms is rehearsed under its own name
-    name = f"{TASK}_randomized_rehearsal" if randomize else f"{TASK}_rehearsal"
+    randomize, name = table.get("randomize") or [], rehearsal_name(table)
     folder = results_folder(Path(cfg.results))
     folder.mkdir(parents=True, exist_ok=True)
     result = {
@@ -252,9 +278,9 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
             "randomize": randomize,
         },
         "seeds": seeds,
-        "checkpoint_choice": choice,
+        "checkpoint_choice": checkpoint_choice_text(table, seeds),
         "trial_seed": settings["trial_seed"],
-        "trial_choice": trial_choice,
+        "trial_choice": trial_choice_text(table, settings),
         "trials": settings["trials"],
         "max_steps": settings["max_steps"],
         "paths": {p: PATHS[p] for p in cfg.paths},
@@ -262,11 +288,37 @@ def run_rehearsal(cfg: RehearsalConfig) -> dict:
         "rows": result_rows,
         "results": [{"variant": r["variant"], "path": p, **r["results"][p]} for r in result_rows for p in cfg.paths],
         "ordering": {p: ordering(result_rows, p) for p in cfg.paths},
-        **runner.record(start, folder / f"{name}.json"),
+        **record,
     }
     (folder / f"{name}.json").write_text(json.dumps(result, indent=2))
     Path(cfg.results).write_text(render_results_page(folder))
     return result
+
+
+def rehearsal_rows(cfg: RehearsalConfig) -> list[str]:
+    """``--rows``, or the rows of the paper's sim-to-real table (those with a real-robot number)."""
+    paper = task_config_class(TASK)().paper_table()
+    return cfg.rows or [r for r in paper.rows if r in paper.real]
+
+
+def run_rehearsal(cfg: RehearsalConfig) -> dict:
+    """Run every (row, path) not yet done; write the rehearsal's JSON and re-render the results page."""
+    start = time.perf_counter()
+    table_dir = Path(cfg.table_dir)
+    table = read_table_config(table_dir)
+    rows = rehearsal_rows(cfg)
+    settings = resolved_settings(cfg, table)
+    out = Path(cfg.output_dir) if cfg.output_dir else table_dir / "rehearsal"
+    check_resumed(out, settings)
+    runner = StepRunner(out, cfg.in_process)
+    seeds = settings["seeds"]
+    print(
+        f"checkpoints: per row, {checkpoint_choice_text(table, seeds)}; "
+        f"trials: {settings['trials']} of {trial_choice_text(table, settings)}"
+    )
+    run_paths(runner, cfg, settings, out, [(row, seed) for row in rows for seed in seeds])
+    record = runner.record(start, results_folder(Path(cfg.results)) / f"{rehearsal_name(table)}.json")
+    return write_rehearsal(cfg, table, settings, out, rows, record)
 
 
 def rehearse_command(cfg: RehearsalConfig) -> dict:

@@ -19,29 +19,29 @@ none (:func:`plan`).
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
-import os
 import re
-import resource
-import shlex
-import signal
-import subprocess
-import sys
-import threading
 import time
 from dataclasses import MISSING, asdict, fields, is_dataclass, replace
-from importlib.metadata import entry_points
 from pathlib import Path
 
-from igen_lerobot.core.exceptions import ConfigError, IgenError
-from igen_lerobot.core.paper import safe_name
-from igen_lerobot.evaluation.checkpoints import best_result
-from igen_lerobot.evaluation.trials import EvalResult, wilson_interval
+from igen_lerobot.core.exceptions import ConfigError
+from igen_lerobot.evaluation.trials import wilson_interval
+from igen_lerobot.experiments.checkpoint_choice import (
+    chosen_result,
+    column_suffix,
+    evaluation_on_record,
+    tested_reports,
+    validation_report,
+)
+from igen_lerobot.experiments.config_rehearsal import PATHS
 from igen_lerobot.experiments.config_table import EARLIER_VALUES, TableConfig
-from igen_lerobot.experiments.ledger import REUSED_FILE, Ledger
-from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
+from igen_lerobot.experiments.ledger import Ledger
+from igen_lerobot.experiments.rehearsal import report_path
+from igen_lerobot.experiments.step_runner import StepRunner
+from igen_lerobot.experiments.table_rehearsal import FOLDER as REHEARSAL_FOLDER
+from igen_lerobot.experiments.table_rehearsal import STEP_PREFIX, TableRehearsal, rehearsal_on_record, rehearsed_rows
 from igen_lerobot.experiments.table_report import render_results_page, results_folder
 from igen_lerobot.experiments.table_steps import (
     BASE_STEPS,
@@ -56,8 +56,6 @@ from igen_lerobot.experiments.table_steps import (
 from igen_lerobot.experiments.training_reuse import (
     KEY_FILE,
     find_identical_training,
-    link_training,
-    records_of_training,
     training_key,
     write_key,
 )
@@ -85,171 +83,9 @@ RESUMABLE_CHANGES = (
     "ledger_dir",
     "retrain_restored",
     "reuse_trainings",
+    "rehearse",
+    "rehearsal",
 )
-
-
-class StepFailedError(IgenError, RuntimeError):
-    """A command of the table failed; the message names it and the end of its log."""
-
-
-class StepRunner:
-    """Runs and records the commands of a resumable run in ``out``; skips those whose output is already complete.
-
-    ``in_process``: call each console script's entry point in this process (same arguments, recorded
-    the same) instead of a subprocess. ``dry_run``: record the commands, run none. ``ledger``: where
-    each finished step's small records are copied as it finishes (:class:`Ledger`).
-    """
-
-    def __init__(
-        self, out: Path, in_process: bool = False, dry_run: bool = False, ledger: Ledger | None = None
-    ) -> None:
-        self.out = Path(out)
-        self.ledger = ledger or Ledger(None, self.out)
-        self.in_process = in_process
-        self.dry_run = dry_run
-        self.bin = Path(sys.executable).parent
-        self.commands: list[dict] = []
-        self.executed: list[str] = []  # the steps this invocation ran (not found done already)
-        self.code = code_version()
-        # step -> seconds and step -> code version, kept on disk so that a table resumed over
-        # several sessions still knows how long every step took and which code made it
-        self.timings_file = self.out / "step_times.json"
-        self.timings: dict[str, float] = _read_json(self.timings_file, {})
-        # step -> CPU seconds (this process and its children): unlike wall time, not stretched by
-        # whatever else the machine ran meanwhile, so a step timed under load still says its cost
-        self.cpu_times_file = self.out / "step_cpu_times.json"
-        self.cpu_times: dict[str, float] = _read_json(self.cpu_times_file, {})
-        self.versions_file = self.out / "step_commits.json"
-        self.versions: dict[str, dict] = _read_json(self.versions_file, {})
-        # step -> wall seconds of its legs that were stopped (a session's end): a resumed step's record
-        # above holds only its finishing leg, so without these a table stopped between sessions would
-        # look cheaper than it was
-        self.interrupted_file = self.out / "step_interrupted_times.json"
-        self.interrupted: dict[str, float] = _read_json(self.interrupted_file, {})
-        # step -> the training of another table it was taken from (training_reuse); its time and
-        # commit above are that training's, so the table's cost still reads as if made from scratch
-        self.reused_file = self.out / REUSED_FILE
-        self.reused: dict[str, str] = _read_json(self.reused_file, {})
-
-    def data(self, name: str) -> Path:
-        return self.out / "data" / name
-
-    def run(
-        self,
-        name: str,
-        command: list[str],
-        done: Path,
-        execute: list[str] | None = None,
-        env: dict[str, str] | None = None,
-    ) -> None:
-        """Run ``command`` unless ``done`` exists; its output is appended to ``logs/<name>.log``.
-
-        ``execute``, when given, is what actually runs (a training resumed from its checkpoint),
-        while ``command`` is what the table records: the command that makes the step from scratch.
-        ``env``: variables the command runs with, recorded in front of it as a shell would take them.
-        """
-        env = env or {}
-        shown = shell_command(command, env)
-        self.commands.append({"step": name, "command": shown})
-        if self.dry_run:
-            return
-        if done.exists():
-            logger.info("%s: done already (%s)", name, done)
-            return
-        log = self.out / "logs" / f"{name}.log"
-        log.parent.mkdir(parents=True, exist_ok=True)
-        command = execute or command
-        self.executed.append(name)
-        logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
-        # the code checked out when this step starts, which is what its subprocess imports: a commit
-        # landed while a long table runs shows in the steps started after it, not in the earlier ones
-        step_code = code_version()
-        start, cpu_start = time.perf_counter(), cpu_seconds()
-        try:
-            with _termination_as_interrupt():
-                if self.in_process:
-                    code = _run_in_process(command, log, env)
-                else:
-                    with open(log, "a") as sink:
-                        code = subprocess.run(
-                            command, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
-                        ).returncode
-        except KeyboardInterrupt:
-            self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
-            self._write_step_records()
-            logger.info("%s: stopped; rerun to resume it", name)
-            raise
-        if code == 0 and done.exists():
-            # a resumed step adds this leg to what earlier legs recorded
-            self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start
-            self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
-            self.versions[name] = step_code
-            self.reused.pop(name, None)  # made here this time
-            self._write_step_records()
-            self.ledger.keep(done)
-        if code != 0 or not done.exists():
-            tail = log.read_text()[-1500:]
-            raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
-
-    def reuse(
-        self, name: str, command: list[str], done: Path, source: Path, output_dir: Path, env: dict[str, str]
-    ) -> None:
-        """Take step ``name`` (a training into ``output_dir``) from ``source``, an identical finished training.
-
-        Recorded as the command that would make it, with the source's times and commit, and named in
-        ``step_reused.json``.
-        """
-        self.commands.append({"step": name, "command": shell_command(command, env)})
-        logger.info("%s: the same data and command as %s; its checkpoints are linked in", name, source)
-        link_training(source, output_dir)
-        self.executed.append(name)
-        own = self._step_records()
-        for file, entry in records_of_training(source).items():
-            own[file][name] = entry
-        self.reused[name] = str(source)
-        self._write_step_records()
-        self.ledger.keep(done)
-
-    def _step_records(self) -> dict[str, dict]:
-        """Each step-record file (``STEP_RECORDS``) and the dict this runner keeps of it."""
-        return {
-            "step_times.json": self.timings,
-            "step_cpu_times.json": self.cpu_times,
-            "step_commits.json": self.versions,
-            "step_interrupted_times.json": self.interrupted,
-            REUSED_FILE: self.reused,
-        }
-
-    def _write_step_records(self) -> None:
-        self.out.mkdir(parents=True, exist_ok=True)
-        for file, entries in self._step_records().items():
-            (self.out / file).write_text(json.dumps(entries, indent=2))
-        self.ledger.keep_step_records()
-
-    def record(self, started: float, recorded: Path) -> dict:
-        """What made the result about to be written to ``recorded``: commits, commands, times.
-
-        ``started``: ``time.perf_counter()`` when this run began. A run that executed no step keeps
-        the commit and wall time ``recorded`` already holds (``keep_assembly_record``).
-        """
-        ran = {step["step"] for step in self.commands}
-        record = {
-            "code": self.code,
-            "step_code": {step: self.versions.get(step) for step in sorted(ran)},
-            "commands": self.commands,
-            "wall_time_s": time.perf_counter() - started,
-            "step_times_s": {step: t for step, t in self.timings.items() if step in ran},
-            "step_cpu_s": {step: t for step, t in self.cpu_times.items() if step in ran},
-            "step_interrupted_s": {step: t for step, t in self.interrupted.items() if step in ran},
-        }
-        reused = {step: source for step, source in self.reused.items() if step in ran}
-        if reused:
-            record["step_reused"] = reused
-        keep_assembly_record(record, recorded, self.executed)
-        return record
-
-    def igen(self, tool: str, *args: str) -> list[str]:
-        return [str(self.bin / tool), *args]
 
 
 class TableRun(StepRunner):
@@ -269,74 +105,6 @@ class TableRun(StepRunner):
         self.choose_on = paper.choose_on if paper is not None else ""
         if not cfg.dry_run:
             self.ledger.keep(self.out / "table_config.json")
-
-
-def shell_command(command: list[str], env: dict[str, str]) -> str:
-    """``command`` as the table records it: its env in front, as a shell takes it, and the tool by name."""
-    return shlex.join([*(f"{k}={v}" for k, v in env.items()), Path(command[0]).name, *command[1:]])
-
-
-def cpu_seconds() -> float:
-    """User + system CPU seconds of this process and of its children that have ended."""
-    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
-
-
-def _raise_interrupt(signum, frame) -> None:
-    raise KeyboardInterrupt(f"signal {signum}")
-
-
-@contextlib.contextmanager
-def _termination_as_interrupt():
-    """SIGTERM (``kill``, the end of a session) ends a step as Ctrl-C does, so its leg is recorded."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
-def _read_json(path: Path, default):
-    return json.loads(path.read_text()) if path.exists() else default
-
-
-def _run_in_process(command: list[str], log: Path, env: dict[str, str]) -> int:
-    """Call the console script's entry point with ``command``'s arguments; its exit status.
-
-    ``OMP_NUM_THREADS`` in ``env`` sets torch's threads for the call (the variable itself is read once,
-    when torch starts).
-    """
-    tool = Path(command[0]).name
-    found = entry_points(group="console_scripts", name=tool)
-    if not found:
-        raise StepFailedError(f"{tool} is not installed in this environment; run `make setup`")
-    main = next(iter(found)).load()
-    saved = sys.argv
-    sys.argv = [tool, *command[1:]]
-    threads = None
-    if "OMP_NUM_THREADS" in env:
-        import torch
-
-        threads = torch.get_num_threads()
-        torch.set_num_threads(int(env["OMP_NUM_THREADS"]))
-    try:
-        with open(log, "a") as sink, contextlib.redirect_stdout(sink):
-            main()
-        return 0
-    except SystemExit as error:
-        return error.code if isinstance(error.code, int) else 1
-    except Exception:  # noqa: BLE001 - reported like a failed subprocess, with the traceback in the log
-        logger.exception("%s failed", tool)
-        return 1
-    finally:
-        sys.argv = saved
-        if threads is not None:
-            import torch
-
-            torch.set_num_threads(threads)
 
 
 def _complete(root: Path) -> Path:
@@ -439,57 +207,6 @@ def train_dir(run: TableRun, variant: str, seed: int) -> Path:
     return run.out / "train" / variant / f"seed{seed}"
 
 
-def validation_report(table_dir: Path, variant: str, seed: int) -> Path:
-    """Where a training run's checkpoints were validated: ``eval/<variant>/seed<k>/validation.json``."""
-    return Path(table_dir) / "eval" / variant / f"seed{seed}" / "validation.json"
-
-
-def chosen_result(validation: dict) -> EvalResult:
-    """The checkpoint a table reports for a training run: the best on its validation trials."""
-    return best_result([EvalResult(**r) for r in validation["results"]])
-
-
-def chosen_checkpoint(table_dir: Path, variant: str, seed: int) -> tuple[int, Path]:
-    """``(step, pretrained_model/)`` of the checkpoint a finished table chose for ``variant``'s run with ``seed``."""
-    table_dir = Path(table_dir)
-    report = validation_report(table_dir, variant, seed)
-    if not report.exists():
-        raise ConfigError(
-            f"{table_dir} has no validation of {variant} with training seed {seed} ({report}); finish its "
-            f"igen-table run first, or pick a row and seed it has"
-        )
-    steps = json.loads((table_dir / "table_config.json").read_text())["train"]["steps"]
-    step = chosen_result(json.loads(report.read_text())).step
-    checkpoint = step_checkpoint(table_dir / "train" / variant / f"seed{seed}", steps, step)
-    if not (checkpoint / "config.json").exists():
-        raise ConfigError(
-            f"{table_dir}: the checkpoint {variant} seed {seed} was tested with ({checkpoint}) is not on this "
-            "machine (its numbers were restored from the table's ledger); rerun its igen-table command with "
-            "--retrain_restored=true to train it again (deterministic: the same weights)"
-        )
-    return step, checkpoint
-
-
-def _column_suffix(column: str) -> str:
-    """How a test step and its report name their column ("" for a table without columns)."""
-    return f"_{safe_name(column)}" if column else ""
-
-
-def tested_reports(out: Path, columns: dict, variant: str, seed: int, step: int) -> dict[str, Path]:
-    """Column -> where the checkpoint chosen at ``step`` was tested (``eval/<variant>/seed<k>/test*_step<n>.json``)."""
-    folder = Path(out) / "eval" / variant / f"seed{seed}"
-    return {column: folder / f"test{_column_suffix(column)}_step{step}.json" for column in columns or {"": ()}}
-
-
-def evaluation_on_record(out: Path, columns: dict, variant: str, seed: int) -> bool:
-    """Whether a training run was validated and its chosen checkpoint tested in every column: its numbers stand."""
-    report = validation_report(out, variant, seed)
-    if not report.exists():
-        return False
-    step = chosen_result(json.loads(report.read_text())).step
-    return all(path.exists() for path in tested_reports(out, columns, variant, seed, step).values())
-
-
 def step_on_record(cfg: TableConfig, columns: dict, step: str) -> bool:
     """Whether a step's output is on record in ``output_dir`` without being made again on this machine.
 
@@ -497,23 +214,37 @@ def step_on_record(cfg: TableConfig, columns: dict, step: str) -> bool:
     evaluation is, except the first seed's base policy, which generation needs as weights. Datasets
     never are (the ledger does not hold them).
     """
+    out = Path(cfg.output_dir)
+    rehearsed = re.fullmatch(rf"{STEP_PREFIX}({'|'.join(PATHS)})_(.+?)_seed(\d+)", step)
+    if rehearsed is not None:
+        return report_path(
+            out / REHEARSAL_FOLDER, rehearsed.group(2), int(rehearsed.group(3)), rehearsed.group(1)
+        ).exists()
     parsed = re.fullmatch(r"(train|validate|test)_(.+?)_seed(\d+)(_.+)?", step)
     if parsed is None:
         return False
     kind, variant, seed = parsed.group(1), parsed.group(2), int(parsed.group(3))
-    out = Path(cfg.output_dir)
     if kind != "train":
         return validation_report(out, variant, seed).exists()
     needed_for_data = variant == "base" and seed == (cfg.train_seeds or [cfg.train.seed])[0]
-    return not needed_for_data and evaluation_on_record(out, columns, variant, seed)
+    return not needed_for_data and run_on_record(cfg, out, columns, variant, seed)
+
+
+def run_on_record(cfg: TableConfig, out: Path, columns: dict, variant: str, seed: int) -> bool:
+    """Whether nothing left of a run needs its weights: evaluated, and rehearsed where the table rehearses it."""
+    if not evaluation_on_record(out, columns, variant, seed):
+        return False
+    if not (cfg.rehearse and variant in rehearsed_rows(cfg.variants)):
+        return True
+    return rehearsal_on_record(out, variant, seed, cfg.rehearsal.paths)
 
 
 def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed: bool = False) -> Path:
     """``lerobot-train`` on a variant's dataset with one seed (same config for all); returns the last checkpoint.
 
-    A run whose evaluation is on record (restored from the table's ledger on a new machine) is not
-    trained again unless ``weights_needed`` (the base policy that generation runs) or the table is
-    asked to (``--retrain_restored``).
+    A run whose evaluation is on record (restored from the table's ledger on a new machine), and in a
+    ``--rehearse`` table its rehearsal too, is not trained again unless ``weights_needed`` (the base
+    policy that generation runs) or the table is asked to (``--retrain_restored``).
     """
     normaliser = observation_stats_args(run.cfg.observation_stats, run.data("base"), dataset)
     cfg = replace(run.cfg.train, seed=seed, extra_args=[*run.cfg.train.extra_args, *normaliser])
@@ -523,7 +254,7 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     command = train_command(cfg, dataset, f"local/{dataset.name}", out)
     execute = None if done.exists() else run_command(cfg, dataset, f"local/{dataset.name}", out)
     may_skip = not (weights_needed or run.cfg.retrain_restored or run.dry_run or done.exists())
-    if may_skip and evaluation_on_record(run.out, run.columns, variant, seed):
+    if may_skip and run_on_record(run.cfg, run.out, run.columns, variant, seed):
         done = validation_report(run.out, variant, seed)  # its numbers stand: no checkpoint is read again
     name, env = f"train_{variant}_seed{seed}", train_env(cfg)
     key, source = None, None
@@ -587,7 +318,7 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     for column, flags in (run.columns or {"": ()}).items():
         tests[column] = _eval(
             run,
-            f"test_{variant}_seed{seed}{_column_suffix(column)}",
+            f"test_{variant}_seed{seed}{column_suffix(column)}",
             reports[column],
             [*flags, f"--policy.path={checkpoint}"],
             cfg.n_trials,
@@ -689,12 +420,15 @@ def run_table(cfg: TableConfig) -> dict:
     env = cfg.env_config()
     paper = cfg.paper_table()
     datasets = build_datasets(run)
+    rehearsal = TableRehearsal(run, cfg) if cfg.rehearse else None
     rows = []
     for variant in cfg.variants:
         seeds = []
         for seed in cfg.train_seeds:
             train(run, variant, datasets[variant], seed)
             seeds.append(evaluate_seed(run, variant, seed))
+            if rehearsal is not None:
+                rehearsal.rehearse(variant, seed)
         rows.append(
             summarise_row(
                 variant,
@@ -721,6 +455,8 @@ def run_table(cfg: TableConfig) -> dict:
     }
     (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
     results.write_text(render_results_page(folder))
+    if rehearsal is not None:
+        rehearsal.write(start)
     return result
 
 
