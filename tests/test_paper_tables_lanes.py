@@ -1,6 +1,7 @@
-"""benchmarks/paper_tables.sh's lanes: a rehearsal (franky in real time) runs with no table beside it.
+"""benchmarks/paper_tables.sh's lanes: while one drives franky-sim in real time, the others are paused.
 
-The lanes run stand-ins for igen-table and igen-rehearse (``BIN``) that only log when they start and end.
+The lanes run a stand-in for igen-table (``BIN``): for the rehearsed table it runs a process named as
+franky-sim for a few seconds, for any other it logs a tick every 0.1 s.
 """
 
 import os
@@ -10,57 +11,71 @@ from pathlib import Path
 
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "paper_tables.sh"
 STAND_IN = """#!/usr/bin/env bash
-echo "start $(basename "$0") $(date +%s.%N)" >> "{log}"
-sleep {seconds}
-echo "end $(basename "$0") $(date +%s.%N)" >> "{log}"
+case "$*" in
+  *block_grasp_randomized*)
+    echo "franky-start $(date +%s.%N)" >> "{log}"
+    bash -c 'exec -a "python tools/franky_sim/serve.py --stand-in" sleep {franky_seconds}'
+    echo "franky-end $(date +%s.%N)" >> "{log}" ;;
+  *)
+    for i in $(seq {ticks}); do echo "tick $(date +%s.%N)" >> "{log}"; sleep 0.1; done ;;
+esac
 """
 
 
-def _lanes_setup(tmp_path: Path, table_seconds: float, rehearsal_seconds: float) -> tuple[dict, Path]:
-    bin_dir, log, out = tmp_path / "bin", tmp_path / "runs.log", tmp_path / "tables"
-    bin_dir.mkdir()
-    for tool, seconds in (("igen-table", table_seconds), ("igen-rehearse", rehearsal_seconds)):
-        (bin_dir / tool).write_text(STAND_IN.format(log=log, seconds=seconds))
-        (bin_dir / tool).chmod(0o755)
-    finished = out / "block_grasp_randomized"  # the table the rehearsal reads
-    (finished / "results").mkdir(parents=True)
-    (finished / "table_config.json").write_text("{}")
-    (finished / "results" / "block_grasp.json").write_text("{}")
-    env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(out), "REDO": "all"}
-    return env, log
-
-
 def _lane(env: dict, name: str) -> subprocess.Popen:
+    # a process group of its own, as the lanes are started (setsid), so that another lane can pause it
     return subprocess.Popen(
-        ["bash", str(SCRIPT), name], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        ["bash", str(SCRIPT), name],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
     )
 
 
-def _times(log: Path) -> dict[str, float]:
-    return {f"{what} {tool}": float(t) for what, tool, t in (line.split() for line in log.read_text().splitlines())}
-
-
-def test_a_lane_started_during_a_rehearsal_waits_for_it_to_end(tmp_path):
-    env, log = _lanes_setup(tmp_path, table_seconds=0.5, rehearsal_seconds=3)
-    rehearsal = _lane(env, "block_grasp_randomized_rehearsal")
-    while not log.exists():  # the rehearsal has started
+def test_a_lane_driving_franky_pauses_the_other_lanes_until_franky_sim_ends(tmp_path):
+    bin_dir, log = tmp_path / "bin", tmp_path / "runs.log"
+    bin_dir.mkdir()
+    (bin_dir / "igen-table").write_text(STAND_IN.format(log=log, franky_seconds=4, ticks=80))
+    (bin_dir / "igen-table").chmod(0o755)
+    env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
+    other = _lane(env, "coffee")
+    while not (log.exists() and "tick" in log.read_text()):
         time.sleep(0.05)
-    table = _lane(env, "coffee")
-    assert table.wait(timeout=60) == 0 and rehearsal.wait(timeout=60) == 0, table.stdout.read()
-    times = _times(log)
-    assert times["start igen-table"] >= times["end igen-rehearse"]
+    rehearsing = _lane(env, "block_grasp_randomized")
+    rehearsing_output = rehearsing.communicate(timeout=60)[0]
+    other_output = other.communicate(timeout=60)[0]
+    assert rehearsing.returncode == 0 and other.returncode == 0, rehearsing_output + other_output
+    events = [line.split() for line in log.read_text().splitlines()]
+    start = next(float(t) for what, t in events if what == "franky-start")
+    end = next(float(t) for what, t in events if what == "franky-end")
+    ticks = [float(t) for what, t in events if what == "tick"]
+    # the watcher looks once a second: paused within ~1 s of franky-sim's start, resumed after its end
+    assert not [t for t in ticks if start + 1.5 < t < end], "the other lane ran while franky-sim did"
+    assert any(t > end for t in ticks) and len(ticks) == 80  # resumed, and it finished its work
+    assert "paused" in rehearsing_output and "lanes resumed" in rehearsing_output, rehearsing_output
 
 
-def test_a_rehearsal_is_skipped_while_another_lane_runs_a_table(tmp_path):
-    env, log = _lanes_setup(tmp_path, table_seconds=3, rehearsal_seconds=0.5)
-    table = _lane(env, "coffee")
-    while not log.exists():
+def test_a_lane_ended_while_it_pauses_another_resumes_it(tmp_path):
+    bin_dir, log = tmp_path / "bin", tmp_path / "runs.log"
+    bin_dir.mkdir()
+    (bin_dir / "igen-table").write_text(STAND_IN.format(log=log, franky_seconds=30, ticks=40))
+    (bin_dir / "igen-table").chmod(0o755)
+    env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
+    other = _lane(env, "coffee")
+    while not (log.exists() and "tick" in log.read_text()):
         time.sleep(0.05)
-    rehearsal = _lane(env, "block_grasp_randomized_rehearsal")
-    output = rehearsal.communicate(timeout=60)[0]
-    assert rehearsal.returncode == 0 and "runs alone, and another lane is running; skipped" in output
-    assert table.wait(timeout=60) == 0
-    assert "start igen-rehearse" not in log.read_text()
+    rehearsing = _lane(env, "block_grasp_randomized")
+    paused = tmp_path / "tables" / ".locks" / f"paused_by.{rehearsing.pid}"  # the groups it paused
+    deadline = time.monotonic() + 30
+    while not (paused.exists() and paused.read_text().split() == [str(other.pid)]):
+        assert time.monotonic() < deadline, "the other lane was never paused"
+        time.sleep(0.1)
+    os.killpg(rehearsing.pid, 15)  # a session's end stops the rehearsing lane (SIGTERM to its group)
+    rehearsing.wait(timeout=30)
+    assert other.wait(timeout=60) == 0  # resumed: it finishes its ticks
+    assert sum(1 for line in log.read_text().splitlines() if line.startswith("tick")) == 40
 
 
 def test_each_published_table_is_what_its_paper_tables_command_makes(tmp_path):
