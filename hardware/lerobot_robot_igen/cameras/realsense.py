@@ -142,12 +142,12 @@ class RealSenseRGBD:
             profile = pipeline.start(rs_config)
         except RuntimeError as error:
             raise CameraError(f"cannot start {self.source}: {error}") from error
+        self._pipeline, self._playback, self.frames_read = pipeline, playback, 0
         try:
             self._configure(profile)
         except BaseException:
-            pipeline.stop()
+            self.stop()
             raise
-        self._pipeline, self._playback, self.frames_read = pipeline, playback, 0
         if playback is not None:
             # resume() waits until the reading thread has handed on a frame, which in non-real-time mode waits
             # for a reader: called here it stalled for its 10 s timeout in about 1 start in 6. Off this thread
@@ -221,12 +221,18 @@ class RealSenseRGBD:
 
     def stop(self) -> None:
         """Stop streaming; safe to call twice."""
-        pipeline, self._pipeline, self._playback, self._align = self._pipeline, None, None, None
+        pipeline, playback, resumer = self._pipeline, self._playback, self._resumer
+        self._pipeline, self._playback, self._align, self._resumer = None, None, None, None
         if pipeline is not None:
             pipeline.stop()
-        resumer, self._resumer = self._resumer, None
         if resumer is not None:
             resumer.join(timeout=1.0)
+        if playback is not None:
+            # Closing the sensors queues work (disable_stream, stop_internal) on the playback's reading thread,
+            # and the device's destructor does not wait for a task that thread has already taken: freed with
+            # the pipeline's last reference, it crashed ("pure virtual method called", about 1 stop in 90).
+            # pause() returns once that thread has run everything queued, so the device goes idle.
+            playback.pause()
 
     def __enter__(self) -> RealSenseRGBD:
         return self.start()
