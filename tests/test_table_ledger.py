@@ -123,9 +123,12 @@ def test_a_rehearsing_table_keeps_each_runs_rehearsal_and_trains_again_only_the_
         assert {f"rehearsal/reports/base/seed{seed}/{path}.json" for path in ("eval", "rendered")} <= kept
     assert "rehearsal/rehearsal_config.json" in kept
 
-    # the machine is lost after seed 8 was tested but before its rehearsal reached the ledger
+    # the machine is lost after seed 8 was tested but before its rehearsal reached the ledger, and the
+    # next one holds the checkout elsewhere
     shutil.rmtree(out)
     (ledger / "rehearsal" / "reports" / "base" / "seed8" / "rendered.json").unlink()
+    recorded = ledger / "rehearsal" / "rehearsal_config.json"
+    recorded.write_text(json.dumps({**json.loads(recorded.read_text()), "table_dir": "/elsewhere/table"}))
     again = tiny_table(out, results, *flags)
     assert again.returncode == 0, again.stderr[-4000:]
     logs = {p.name for p in (out / "logs").glob("*.log")}

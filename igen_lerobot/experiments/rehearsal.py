@@ -75,15 +75,20 @@ def resolved_settings(cfg: RehearsalConfig, table: dict) -> dict:
     return settings
 
 
-def check_resumed(out: Path, settings: dict) -> None:
-    """Refuse to resume a rehearsal under settings that change what its finished steps made."""
+def check_resumed(out: Path, settings: dict, same_table: bool = False) -> None:
+    """Refuse to resume a rehearsal under settings that change what its finished steps made.
+
+    ``same_table``: the rehearsal lives inside its table (``igen-table --rehearse``), which a new
+    machine may hold at another absolute path; the table's own check guards the rest.
+    """
     recorded_file = out / "rehearsal_config.json"
     if not recorded_file.exists():
         out.mkdir(parents=True, exist_ok=True)
         recorded_file.write_text(json.dumps(settings, indent=2))
         return
     recorded = json.loads(recorded_file.read_text())
-    changed = [f"{k}: {recorded.get(k)} -> {settings[k]}" for k in FIXED if recorded.get(k) != settings[k]]
+    fixed = [k for k in FIXED if not (same_table and k == "table_dir")]
+    changed = [f"{k}: {recorded.get(k)} -> {settings[k]}" for k in fixed if recorded.get(k) != settings[k]]
     if changed:
         raise ConfigError(
             f"{out} holds a rehearsal made with other settings ({'; '.join(changed)}); give the same flags to "

@@ -51,9 +51,10 @@ class TableRehearsal:
         self.runner, self.out = runner, table_dir / FOLDER
         self.cfg = table.rehearsal.as_rehearsal(str(table_dir), results=table.results, in_process=table.in_process)
         self.table = read_table_config(Path(table_dir))
-        self.settings = resolved_settings(self.cfg, self.table)
+        # the table's path as the table names it: the reports and the JSON move with the checkout
+        self.settings = {**resolved_settings(self.cfg, self.table), "table_dir": str(table_dir)}
         self.rows = rehearsed_rows(table.variants)
-        check_resumed(self.out, self.settings)
+        check_resumed(self.out, self.settings, same_table=True)
         runner.ledger.keep(self.out / "rehearsal_config.json")
 
     def rehearse(self, variant: str, seed: int) -> None:
