@@ -476,3 +476,21 @@ def test_each_step_records_the_code_checked_out_when_it_started(tmp_path, monkey
     runner.run("first", ["touch", str(tmp_path / "first")], tmp_path / "first")  # started at commit b
     assert runner.code["commit"] == "a" * 40
     assert json.loads((tmp_path / "step_commits.json").read_text())["first"]["commit"] == "b" * 40
+
+
+def test_a_rehearsing_tables_plan_shows_each_sim_to_real_runs_paths_after_its_test(tmp_path):
+    """--rehearse: the plan lists each path of a sim-to-real row's run right after that run's test (with the
+    last checkpoint, as its test), none for other rows, and writes nothing; other tasks are refused."""
+    from igen_lerobot.experiments.table import plan
+
+    out = tmp_path / "t"
+    cfg = TableConfig(variants=["source_demo", "igen"], train_seeds=[5], rehearse=True, output_dir=str(out))
+    cfg.rehearsal.paths = ["franky", "eval"]
+    steps = [s["step"] for s in plan(cfg)]
+    assert not out.exists()
+    assert [s for s in steps if s.startswith("rehearse_")] == ["rehearse_eval_igen_seed5", "rehearse_franky_igen_seed5"]
+    assert steps.index("rehearse_eval_igen_seed5") == steps.index("test_igen_seed5") + 1
+    franky = next(s["command"] for s in plan(cfg) if s["step"] == "rehearse_franky_igen_seed5")
+    assert "--robot.type=franky" in franky and "--trials=20" in franky and "checkpoints/002000" in franky
+    with pytest.raises(ConfigError, match="--rehearse=true rehearses --task=block_grasp's main table"):
+        TableConfig(task="nut_insertion", rehearse=True)

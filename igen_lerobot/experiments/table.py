@@ -401,10 +401,13 @@ def plan(cfg: TableConfig) -> list[dict]:
     """
     run = TableRun(replace(cfg, dry_run=True))
     datasets = build_datasets(run)
+    rehearsal = TableRehearsal(run, cfg) if cfg.rehearse else None
     for variant in cfg.variants:
         for seed in cfg.train_seeds:
             train(run, variant, datasets[variant], seed)
             evaluate_seed(run, variant, seed)
+            if rehearsal is not None:
+                rehearsal.rehearse(variant, seed)
     return run.commands
 
 

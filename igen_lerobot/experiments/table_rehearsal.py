@@ -12,12 +12,14 @@ JSON are the rehearsal's own (``<output_dir>/rehearsal``, ``<name>_rehearsal.jso
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from pathlib import Path
 
 from igen_lerobot.experiments.config_rehearsal import RehearsalConfig
 from igen_lerobot.experiments.config_table import TableConfig
 from igen_lerobot.experiments.rehearsal import (
     check_resumed,
+    path_command,
     read_table_config,
     rehearsal_name,
     rehearsal_rows,
@@ -28,6 +30,7 @@ from igen_lerobot.experiments.rehearsal import (
 )
 from igen_lerobot.experiments.step_runner import StepRunner
 from igen_lerobot.experiments.table_report import results_folder
+from igen_lerobot.training.lerobot_train import step_checkpoint
 
 STEP_PREFIX = "rehearse_"  # the table's rehearsal steps: rehearse_<path>_<row>_seed<k>
 FOLDER = "rehearsal"  # inside the table's output_dir (and ledger): igen-rehearse's default output_dir
@@ -50,17 +53,30 @@ class TableRehearsal:
         table_dir = Path(table.output_dir)
         self.runner, self.out = runner, table_dir / FOLDER
         self.cfg = table.rehearsal.as_rehearsal(str(table_dir), results=table.results, in_process=table.in_process)
-        self.table = read_table_config(Path(table_dir))
+        # a plan (--dry_run) has no table folder yet: the table's config is the one it would record
+        self.table = json.loads(json.dumps(asdict(table))) if runner.dry_run else read_table_config(table_dir)
         # the table's path as the table names it: the reports and the JSON move with the checkout
         self.settings = {**resolved_settings(self.cfg, self.table), "table_dir": str(table_dir)}
         self.rows = rehearsed_rows(table.variants)
-        check_resumed(self.out, self.settings, same_table=True)
-        runner.ledger.keep(self.out / "rehearsal_config.json")
+        self.steps = table.train.steps
+        if not runner.dry_run:
+            check_resumed(self.out, self.settings, same_table=True)
+            runner.ledger.keep(self.out / "rehearsal_config.json")
 
     def rehearse(self, variant: str, seed: int) -> None:
         """Run the paths of one tested run of a sim-to-real row that are not on record (other rows: nothing)."""
-        if variant in self.rows:
+        if variant not in self.rows:
+            return
+        if not self.runner.dry_run:
             run_paths(self.runner, self.cfg, self.settings, self.out, [(variant, seed)], step_prefix=STEP_PREFIX)
+            return
+        # a plan shows the last checkpoint, as its test steps do: the choice needs the validation trials
+        trained = Path(self.settings["table_dir"]) / "train" / variant / f"seed{seed}"
+        checkpoint = step_checkpoint(trained, self.steps, self.steps)
+        for path in self.cfg.paths:
+            report = report_path(self.out, variant, seed, path)
+            command = path_command(self.runner, path, checkpoint, self.settings, report, self.cfg)
+            self.runner.run(f"{STEP_PREFIX}{path}_{variant}_seed{seed}", command, report)
 
     def write(self, started: float) -> dict:
         """The rehearsal's JSON from every run's reports, recorded with the rehearsal's steps only."""
