@@ -34,16 +34,21 @@ def _lane(env: dict, name: str) -> subprocess.Popen:
     )
 
 
-def test_a_lane_driving_franky_pauses_the_other_lanes_until_franky_sim_ends(tmp_path):
+def _two_lanes(tmp_path: Path, franky_seconds: float, ticks: int) -> tuple[Path, subprocess.Popen, subprocess.Popen]:
+    """A lane ticking through a table, then a lane whose table runs franky-sim for ``franky_seconds``."""
     bin_dir, log = tmp_path / "bin", tmp_path / "runs.log"
     bin_dir.mkdir()
-    (bin_dir / "igen-table").write_text(STAND_IN.format(log=log, franky_seconds=4, ticks=80))
+    (bin_dir / "igen-table").write_text(STAND_IN.format(log=log, franky_seconds=franky_seconds, ticks=ticks))
     (bin_dir / "igen-table").chmod(0o755)
     env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
     other = _lane(env, "coffee")
     while not (log.exists() and "tick" in log.read_text()):
         time.sleep(0.05)
-    rehearsing = _lane(env, "block_grasp_randomized")
+    return log, other, _lane(env, "block_grasp_randomized")
+
+
+def test_a_lane_driving_franky_pauses_the_other_lanes_until_franky_sim_ends(tmp_path):
+    log, other, rehearsing = _two_lanes(tmp_path, franky_seconds=4, ticks=80)
     rehearsing_output = rehearsing.communicate(timeout=60)[0]
     other_output = other.communicate(timeout=60)[0]
     assert rehearsing.returncode == 0 and other.returncode == 0, rehearsing_output + other_output
@@ -58,15 +63,7 @@ def test_a_lane_driving_franky_pauses_the_other_lanes_until_franky_sim_ends(tmp_
 
 
 def test_a_lane_ended_while_it_pauses_another_resumes_it(tmp_path):
-    bin_dir, log = tmp_path / "bin", tmp_path / "runs.log"
-    bin_dir.mkdir()
-    (bin_dir / "igen-table").write_text(STAND_IN.format(log=log, franky_seconds=30, ticks=40))
-    (bin_dir / "igen-table").chmod(0o755)
-    env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
-    other = _lane(env, "coffee")
-    while not (log.exists() and "tick" in log.read_text()):
-        time.sleep(0.05)
-    rehearsing = _lane(env, "block_grasp_randomized")
+    log, other, rehearsing = _two_lanes(tmp_path, franky_seconds=30, ticks=40)
     paused = tmp_path / "tables" / ".locks" / f"paused_by.{rehearsing.pid}"  # the groups it paused
     deadline = time.monotonic() + 30
     while not (paused.exists() and paused.read_text().split() == [str(other.pid)]):
