@@ -9,12 +9,13 @@ paths (a row's cell pools its seeds, each seed's count shown beside it):
 - ``franky``: ``igen-deploy`` through the franky backend against franky-sim (another simulator
   behind libfranka's protocol, paced at 20 Hz), started and stopped here.
 
-A console script of its own (``igen-rehearse``) rather than ``igen-table --rehearse``: it reads a
-finished table instead of making one, and its flags (rows, paths, trials, franky-sim) share nothing
-with the table's protocol, which ``igen-table`` refuses to change on a resumed run. It reuses the
-table's machinery: every (row, path) is one recorded command run by :class:`StepRunner` (skipped
-when its report exists, so a rerun resumes; commit and wall time per step in ``step_commits.json``
-and ``step_times.json``), and its JSON goes into the results folder, whose page renders it.
+``igen-rehearse`` reads a finished table whose checkpoints are on this machine; its flags (rows,
+paths, trials, franky-sim) change no number of the table. ``igen-table --rehearse=true`` runs the
+same paths on each run as soon as it is tested (:mod:`~igen_lerobot.experiments.table_rehearsal`),
+for a table that outlives its machine. Both use the table's machinery: every (row, seed, path) is
+one recorded command run by :class:`StepRunner` (skipped when its report exists, so a rerun resumes;
+commit and wall time per step in ``step_commits.json`` and ``step_times.json``), and the JSON goes
+into the results folder, whose page renders it.
 """
 
 from __future__ import annotations
@@ -199,7 +200,9 @@ def run_paths(
 
     Only a pending step reads its checkpoint, so runs whose reports a ledger restored need no weights
     here. franky-sim is started once for the pending franky steps, and it and they run at normal
-    priority (:func:`normal_priority`): they are paced in real time, beside a niced table's neighbours.
+    priority (:func:`normal_priority`) in a niced table. That is not enough beside busy neighbours
+    (docs/benchmarks.md): whoever runs other work beside a rehearsal pauses it meanwhile, as
+    ``benchmarks/paper_tables.sh``'s lanes do.
     """
     table_dir = Path(settings["table_dir"])
 
