@@ -14,6 +14,7 @@ use it: about 1.35x less CPU a step, but a policy that learnt less (docs/benchma
 from __future__ import annotations
 
 import functools
+import logging
 
 import torch
 from lerobot.policies.pretrained import PreTrainedPolicy
@@ -21,6 +22,8 @@ from torch import Tensor, nn
 from torch.distributions import Categorical, Independent, MixtureSameFamily, Normal
 
 from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+
+logger = logging.getLogger(__name__)
 
 ACTION = "action"
 LOW_NOISE_STD = 1e-4
@@ -118,13 +121,30 @@ class BCRNNPolicy(PreTrainedPolicy):
     def _inputs(self, batch: dict[str, Tensor]) -> Tensor:
         return torch.cat([batch[k] for k in self.input_keys], dim=-1)
 
+    def _rnn(self, inputs: Tensor, hidden=None):
+        """The LSTM, under the active autocast where this CPU can run it so, else in float32.
+
+        oneDNN has no bfloat16 LSTM on CPUs without avx512 (it cannot create the primitive): there
+        ``--policy.use_amp`` trains the LSTM in float32, as if the flag were off for it, and logs once.
+        """
+        try:
+            return self.rnn(inputs, hidden)
+        except RuntimeError as error:
+            if not (torch.is_autocast_enabled(inputs.device.type) and "LSTM" in str(error)):
+                raise
+            if not getattr(self, "_warned_float32_rnn", False):
+                logger.warning("this CPU has no bfloat16 LSTM (%s); the LSTM runs in float32", str(error)[:80])
+                self._warned_float32_rnn = True
+            with _float32(inputs.device.type):
+                return self.rnn(inputs.float(), hidden)
+
     def _distribution(self, inputs: Tensor, hidden=None, low_noise: bool = False):
         """The action mixture after the RNN; the RNN alone follows an active autocast (``--policy.use_amp``).
 
         The head and its likelihood stay in float32: a mixture of scales down to ``gmm_min_std``
         (1e-4) cannot be evaluated in bfloat16's 8 bits of mantissa.
         """
-        out, hidden = self.rnn(inputs, hidden)
+        out, hidden = self._rnn(inputs, hidden)
         with _float32(out.device.type):
             return self.head(self.mlp(out.float()), low_noise=low_noise), hidden
 
