@@ -127,16 +127,17 @@ class BCRNNPolicy(PreTrainedPolicy):
         oneDNN has no bfloat16 LSTM on CPUs without avx512 (it cannot create the primitive): there
         ``--policy.use_amp`` trains the LSTM in float32, as if the flag were off for it, and logs once.
         """
-        try:
-            return self.rnn(inputs, hidden)
-        except RuntimeError as error:
-            if not (torch.is_autocast_enabled(inputs.device.type) and "LSTM" in str(error)):
-                raise
-            if not getattr(self, "_warned_float32_rnn", False):
+        autocast = torch.is_autocast_enabled(inputs.device.type)
+        if not (autocast and getattr(self, "_rnn_in_float32", False)):
+            try:
+                return self.rnn(inputs, hidden)
+            except RuntimeError as error:
+                if not (autocast and "LSTM" in str(error)):
+                    raise
                 logger.warning("this CPU has no bfloat16 LSTM (%s); the LSTM runs in float32", str(error)[:80])
-                self._warned_float32_rnn = True
-            with _float32(inputs.device.type):
-                return self.rnn(inputs.float(), hidden)
+                self._rnn_in_float32 = True  # found once: every later step goes straight to float32
+        with _float32(inputs.device.type):
+            return self.rnn(inputs.float(), hidden)
 
     def _distribution(self, inputs: Tensor, hidden=None, low_noise: bool = False):
         """The action mixture after the RNN; the RNN alone follows an active autocast (``--policy.use_amp``).
