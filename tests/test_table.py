@@ -481,6 +481,7 @@ def test_each_step_records_the_code_checked_out_when_it_started(tmp_path, monkey
 def test_a_rehearsing_tables_plan_shows_each_sim_to_real_runs_paths_after_its_test(tmp_path):
     """--rehearse: the plan lists each path of a sim-to-real row's run right after that run's test (with the
     last checkpoint, as its test), none for other rows, and writes nothing; other tasks are refused."""
+    from igen_lerobot.experiments.config_table import TableRehearsalConfig
     from igen_lerobot.experiments.table import plan
 
     out = tmp_path / "t"
@@ -494,3 +495,7 @@ def test_a_rehearsing_tables_plan_shows_each_sim_to_real_runs_paths_after_its_te
     assert "--robot.type=franky" in franky and "--trials=20" in franky and "checkpoints/002000" in franky
     with pytest.raises(ConfigError, match="--rehearse=true rehearses --task=block_grasp's main table"):
         TableConfig(task="nut_insertion", rehearse=True)
+    with pytest.raises(ConfigError, match=r"--rehearsal.paths must be distinct names among"):
+        TableConfig(rehearse=True, rehearsal=TableRehearsalConfig(paths=["eval", "camera"]))
+    with pytest.raises(ConfigError, match=r"--rehearsal.trials must be >= 1"):
+        TableConfig(rehearsal=TableRehearsalConfig(trials=0))

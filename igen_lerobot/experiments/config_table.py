@@ -161,7 +161,10 @@ class TableConfig:
                 f"--rehearse=true rehearses --task={REHEARSED_TASK}'s main table under full observability "
                 f"(the paper's sim-to-real task), not --task={self.task} --reveal={self.reveal} --table={self.table}"
             )
-        self.rehearsal.paths = self.rehearsal.as_rehearsal(".").paths  # checked, in the order they run
+        try:  # checked by igen-rehearse's own config, in the order they run
+            self.rehearsal.paths = self.rehearsal.as_rehearsal(".").paths
+        except ConfigError as error:  # its message names igen-rehearse's flag: name this table's
+            raise ConfigError(str(error).replace("--", "--rehearsal.", 1)) from None
         check_observation_stats(self.observation_stats, self.train.policy_type)
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")
