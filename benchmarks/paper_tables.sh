@@ -17,6 +17,10 @@
 # ends or the lane dies). Measured: beside two niced trainings, franky at nice 0 lost every trial to
 # the watchdog; with one niced neighbour its clock ran at 0.75 of the wall's (docs/benchmarks.md).
 # Start each lane in a process group of its own (setsid), or it cannot be paused.
+# Linux's autogroup scheduling (on by default) shares the CPU between sessions first and applies nice
+# only within one: a lane started with setsid is a session of its own, so its nice alone would not
+# yield to a user's shell or CI (measured: two nice-10 lanes took 60% of the CPU from a test run). A
+# lane that leads its session gives the session its nice, and normal priority while its franky-sim runs.
 #
 # block_grasp_randomized is the Block Grasp table generated on randomised arms (the data that
 # transfer, docs/benchmarks.md), rehearsed as it goes (igen-table --rehearse: each run of the paper's
@@ -112,11 +116,23 @@ if [ "${DRY_RUN:-false}" != true ]; then
         && echo "$(date +%T) franky-sim runs in real time: lane $group paused"
     done
   }
+  lane_nice=$(nice)
+  set_session_nice() {  # only a lane that leads its session: else it would renice its user's shell
+    [ "$(ps -o sid= -p $$ | tr -d ' ')" = "$$" ] && [ -w "/proc/$$/autogroup" ] || return 0
+    echo "$1" > "/proc/$$/autogroup" 2>/dev/null \
+      || echo "$(date +%T) cannot set this lane's session to nice $1 (/proc/$$/autogroup)"
+  }
+  set_session_nice "$lane_nice"
   ( # the watcher: other lanes pause while this lane's franky-sim lives
     trap 'resume_paused; exit 0' TERM
+    franky=false
     while sleep 1; do
-      if drives_franky; then pause_others
-      else resume_paused
+      if drives_franky; then
+        pause_others
+        $franky || { set_session_nice 0; franky=true; }
+      else
+        resume_paused
+        ! $franky || { set_session_nice "$lane_nice"; franky=false; }
       fi
     done
   ) &

@@ -9,6 +9,8 @@ import subprocess
 import time
 from pathlib import Path
 
+import pytest
+
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "paper_tables.sh"
 STAND_IN = """#!/usr/bin/env bash
 case "$*" in
@@ -73,6 +75,34 @@ def test_a_lane_ended_while_it_pauses_another_resumes_it(tmp_path):
     rehearsing.wait(timeout=30)
     assert other.wait(timeout=60) == 0  # resumed: it finishes its ticks
     assert sum(1 for line in log.read_text().splitlines() if line.startswith("tick")) == 40
+
+
+SESSION_NICE_STAND_IN = """#!/usr/bin/env bash
+read_nice() { echo "$1 $(cut -d' ' -f3 /proc/self/autogroup)" >> "{log}"; }
+read_nice before
+bash -c 'exec -a "python tools/franky_sim/serve.py --stand-in" sleep 4' &
+sleep 2.5; read_nice during
+wait; sleep 2.5; read_nice after
+"""
+
+
+def test_a_lane_gives_its_session_its_nice_and_normal_priority_while_franky_runs(tmp_path):
+    """A setsid lane is a session of its own, which autogroup scheduling weighs against the user's shell
+    whatever its processes' nice: the lane sets its session's nice to its own (normal while franky-sim runs)."""
+    if not Path("/proc/self/autogroup").exists():
+        pytest.skip("this kernel has no autogroup scheduling: nice alone orders the lanes")
+    bin_dir, log = tmp_path / "bin", tmp_path / "nice.log"
+    bin_dir.mkdir()
+    (bin_dir / "igen-table").write_text(SESSION_NICE_STAND_IN.replace("{log}", str(log)))
+    (bin_dir / "igen-table").chmod(0o755)
+    env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
+    lane = subprocess.Popen(
+        ["nice", "-n", "7", "bash", str(SCRIPT), "coffee"], env=env, stdout=subprocess.PIPE, text=True, start_new_session=True
+    )
+    output = lane.communicate(timeout=60)[0]
+    assert lane.returncode == 0, output
+    # the watcher looks once a second: the stand-in reads 2.5 s after franky-sim starts and after it ends
+    assert dict(line.split() for line in log.read_text().splitlines()) == {"before": "7", "during": "0", "after": "7"}
 
 
 def test_each_published_table_is_what_its_paper_tables_command_makes(tmp_path):
