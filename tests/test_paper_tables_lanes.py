@@ -97,7 +97,11 @@ def test_a_lane_gives_its_session_its_nice_and_normal_priority_while_franky_runs
     (bin_dir / "igen-table").chmod(0o755)
     env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
     lane = subprocess.Popen(
-        ["nice", "-n", "7", "bash", str(SCRIPT), "coffee"], env=env, stdout=subprocess.PIPE, text=True, start_new_session=True
+        ["nice", "-n", "7", "bash", str(SCRIPT), "coffee"],
+        env=env,
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
     )
     output = lane.communicate(timeout=60)[0]
     assert lane.returncode == 0, output
