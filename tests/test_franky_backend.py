@@ -448,10 +448,16 @@ def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(e
         arm.send_target(T)
         time.sleep(2.0)
         assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.05
-        # no Cartesian plan exists. The deadline is the fallback's, not what this test is about: the
-        # joint-space move home at 5% acceleration and jerk ran past the 30 s default in CI, when
-        # franky-sim's clock had fallen to about half of wall time
-        arm.config = replace(arm.config, home_position=(float("nan"), 0.0, 0.2), home_timeout=120.0)
+        # no Cartesian plan exists. The deadline and the pace are the fallback's, not what this test is
+        # about: the joint-space move home at 5% acceleration and jerk ran past the 30 s default in CI,
+        # when franky-sim's clock had fallen to about half of wall time; at 20% it takes a few seconds
+        arm.config = replace(
+            arm.config,
+            home_position=(float("nan"), 0.0, 0.2),
+            home_timeout=120.0,
+            acceleration_factor=0.2,
+            jerk_factor=0.2,
+        )
         arm.move_home()
         np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)  # tolerance 5 mm
     finally:

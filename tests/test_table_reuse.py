@@ -4,7 +4,7 @@ import json
 import os
 from pathlib import Path
 
-from igen_lerobot.experiments.training_reuse import KEY_FILE, dataset_digest, training_key
+from igen_lerobot.experiments.training_reuse import KEY_FILE, dataset_digest, find_identical_training, training_key
 
 ONE_RUN = ("--variants=[base]", "--train_seeds=[7]", "--train.save_freq=1")
 
@@ -38,8 +38,14 @@ def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp
     assert report["step_reused"] == {"train_base_seed7": str(made)}
     assert "- Reused: 1 training taken from first" in results.read_text()
 
-    # another command (more steps) is another training: made, not taken
-    third = tiny_table(tables / "third", results, *ONE_RUN, "--train.steps=3")
+    # another command or other data is another key (test_the_key_is_..., below): nothing is taken for it
+    key = json.loads((made / KEY_FILE).read_text())["key"]
+    elsewhere = tables / "third" / "train" / "base" / "seed7"
+    assert find_identical_training(tables, key, elsewhere, 2) == made
+    assert find_identical_training(tables, "another key", elsewhere, 2) is None
+
+    # a table that is told not to reuse trains its own
+    third = tiny_table(tables / "third", results, *ONE_RUN, "--reuse_trainings=false")
     assert third.returncode == 0, third.stderr[-4000:]
     assert json.loads((tables / "third" / "step_reused.json").read_text()) == {}
     made_again = tables / "third" / "train" / "base" / "seed7" / "checkpoints" / "000002"
@@ -47,11 +53,6 @@ def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp
         os.stat(made_again / "pretrained_model" / "model.safetensors").st_ino
         != os.stat(made / "checkpoints" / "000002" / "pretrained_model" / "model.safetensors").st_ino
     )
-
-    # a table that is told not to reuse trains its own
-    fourth = tiny_table(tables / "fourth", results, *ONE_RUN, "--reuse_trainings=false")
-    assert fourth.returncode == 0, fourth.stderr[-4000:]
-    assert json.loads((tables / "fourth" / "step_reused.json").read_text()) == {}
 
 
 def _dataset(root: Path, data: bytes, stats: dict, meta: dict) -> Path:

@@ -25,6 +25,7 @@ from igen_lerobot.core.cameras import CameraConfig, image_key
 from igen_lerobot.core.error_models import ErrorModel, NoNoise
 from igen_lerobot.core.exceptions import ConfigError, UnknownTaskError
 from igen_lerobot.core.paper import PaperTable
+from igen_lerobot.core.plugins import discover_plugins
 from igen_lerobot.core.task import ACTION, OBS_ENV_STATE, OBS_STATE, TaskEnv, TaskSpec
 
 __all__ = [
@@ -190,15 +191,9 @@ def register_gym_env(config_class: type[TaskEnvConfig]) -> str:
     return gym_id
 
 
-def _discover_plugins() -> None:
-    from lerobot.utils.import_utils import register_third_party_plugins
-
-    register_third_party_plugins()
-
-
 def known_tasks() -> dict[str, type[TaskEnvConfig]]:
     """Every registered igen task: env type name -> config class."""
-    _discover_plugins()
+    discover_plugins()
     return {
         name: cls
         for name, cls in EnvConfig.get_known_choices().items()

@@ -32,11 +32,12 @@ def run_cli(config_class: type, command: Callable[..., object], prog: str) -> No
     one difference: when a config check of ours fails deep inside draccus (an env config inside a
     union, say), the user sees our message with its fix, not draccus's "could not decode".
     """
-    from lerobot.utils.import_utils import register_third_party_plugins
     from lerobot.utils.utils import init_logging
 
+    from igen_lerobot.core.plugins import discover_plugins
+
     init_logging()
-    register_third_party_plugins()
+    discover_plugins()
     try:
         cfg = parse_config(config_class, sys.argv[1:])
         command(cfg)

@@ -57,11 +57,12 @@ def check_policy_features(
 def read_checkpoint_config(path: str | Path, spec: TaskSpec, cameras: CameraConfig | None = None):
     """The checkpoint's LeRobot config, checked against ``spec`` and the observed ``cameras`` (no weights loaded)."""
     from lerobot.configs.policies import PreTrainedConfig
-    from lerobot.utils.import_utils import register_third_party_plugins
+
+    from igen_lerobot.core.plugins import discover_plugins
 
     # Plugin policy types (bc_rnn) must be registered in every process that loads one,
     # generation workers included, not only in the one that parsed the command line.
-    register_third_party_plugins()
+    discover_plugins()
     path = Path(path)
     if not (path / "config.json").exists():
         raise ConfigError(
