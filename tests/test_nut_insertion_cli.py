@@ -67,7 +67,7 @@ def data(tmp_path_factory):
                 NUT,
                 f"--source.root={root / source}",
                 "--num_episodes=4",
-                "--workers=2",
+                "--workers=1",  # the 2-worker path: test_generation_runner.py
                 f"--dataset.root={root / mode}",
             )
         )
