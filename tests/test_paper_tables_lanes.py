@@ -24,10 +24,10 @@ esac
 """
 
 
-def _lane(env: dict, name: str) -> subprocess.Popen:
+def _lane(env: dict, name: str, nice: int = 0) -> subprocess.Popen:
     # a process group of its own, as the lanes are started (setsid), so that another lane can pause it
     return subprocess.Popen(
-        ["bash", str(SCRIPT), name],
+        ["nice", "-n", str(nice), "bash", str(SCRIPT), name],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
@@ -96,13 +96,7 @@ def test_a_lane_gives_its_session_its_nice_and_normal_priority_while_franky_runs
     (bin_dir / "igen-table").write_text(SESSION_NICE_STAND_IN.replace("{log}", str(log)))
     (bin_dir / "igen-table").chmod(0o755)
     env = {**os.environ, "BIN": str(bin_dir), "OUT_ROOT": str(tmp_path / "tables"), "REDO": "all"}
-    lane = subprocess.Popen(
-        ["nice", "-n", "7", "bash", str(SCRIPT), "coffee"],
-        env=env,
-        stdout=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
+    lane = _lane(env, "coffee", nice=7)
     output = lane.communicate(timeout=60)[0]
     assert lane.returncode == 0, output
     # the watcher looks once a second: the stand-in reads 2.5 s after franky-sim starts and after it ends
