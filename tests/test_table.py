@@ -183,6 +183,57 @@ def test_every_step_records_the_machine_it_ran_on_and_the_page_says_when_they_di
     assert machine_line(older) == "- Machine: not recorded (the steps ran before machines were)."
 
 
+def test_a_training_step_records_the_digest_of_the_data_it_read_and_the_ledger_keeps_it(tmp_path):
+    from igen_lerobot.experiments.ledger import Ledger
+    from igen_lerobot.experiments.step_runner import StepRunner
+    from igen_lerobot.experiments.training_reuse import dataset_digest
+
+    data = tmp_path / "data" / "base"
+    (data / "meta").mkdir(parents=True)
+    (data / "meta" / "info.json").write_text("{}")
+    out, ledger = tmp_path / "table", tmp_path / "ledger"
+    runner = StepRunner(out, ledger=Ledger(ledger, out))
+    runner.run("train_base_seed1", ["touch", str(tmp_path / "one")], tmp_path / "one", reads=data)
+    runner.run("test_base_seed1", ["touch", str(tmp_path / "two")], tmp_path / "two")  # reads no dataset
+    recorded = {"train_base_seed1": dataset_digest(data)}
+    assert json.loads((out / "step_data.json").read_text()) == recorded
+    assert json.loads((ledger / "step_data.json").read_text()) == recorded
+    assert runner.record(0.0, tmp_path / "t.json")["step_data"] == recorded
+    # the same recipe made again, with other bytes: another digest
+    (data / "meta" / "info.json").write_text('{"episodes": 2}')
+    (tmp_path / "one").unlink()
+    runner.run("train_base_seed1", ["touch", str(tmp_path / "one")], tmp_path / "one", reads=data)
+    assert runner.data_digests["train_base_seed1"] != recorded["train_base_seed1"]
+
+
+def test_the_page_names_rows_whose_seeds_were_trained_on_other_machines_or_other_data():
+    from igen_lerobot.experiments.provenance import seeds_made_apart_lines
+
+    def row(variant, seeds):
+        return {"variant": variant, "label": variant.title(), "seeds": [{"seed": s} for s in seeds]}
+
+    here, there = {"commit": "a" * 40, "machine": "CPU avx2"}, {"commit": "a" * 40, "machine": "CPU avx512f"}
+    result = {
+        "rows": [row("base", [1, 2]), row("mg", [1, 2, 3]), row("igen", [1, 2])],
+        "step_code": {
+            "train_base_seed1": here, "train_base_seed2": here,
+            "train_mg_seed1": there, "train_mg_seed2": there, "train_mg_seed3": here,
+            "train_igen_seed1": here, "train_igen_seed2": here,
+        },
+        "step_data": {"train_base_seed1": "d" * 64, "train_base_seed2": "d" * 64, "train_mg_seed3": "e" * 64,
+                      "train_igen_seed1": "d" * 64, "train_igen_seed2": "f" * 64},
+    }  # fmt: skip
+    lines = seeds_made_apart_lines(result)
+    assert lines[0].startswith("- Rows whose seeds were made apart")
+    assert lines[1:] == [
+        "  - Mg: seeds trained on 2 machines (seeds 1, 2: CPU avx512f; seed 3: CPU avx2), on 2 datasets by "
+        f"digest (seeds 1, 2: not recorded; seed 3: {'e' * 12}).",
+        "  - Igen: seeds trained on one machine (CPU avx2), on 2 datasets by digest "
+        f"(seed 1: {'d' * 12}; seed 2: {'f' * 12}).",
+    ]  # Base: one machine, one dataset: not named
+    assert seeds_made_apart_lines({**result, "rows": [row("base", [1, 2])]}) == []
+
+
 def test_the_code_line_counts_steps_per_commit():
     from igen_lerobot.experiments.provenance import code_line
 

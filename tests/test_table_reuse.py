@@ -34,8 +34,12 @@ def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp
         taken_records = json.loads((tables / "second" / records).read_text())
         assert taken_records["train_base_seed7"] == made_records["train_base_seed7"]
         assert {"validate_base_seed7", "test_base_seed7"} <= taken_records.keys()
+    # both read the same data, and each says so by its digest
+    read = {"train_base_seed7": dataset_digest(tables / "first" / "data" / "base")}
+    assert json.loads((tables / "first" / "step_data.json").read_text()) == read
+    assert json.loads((tables / "second" / "step_data.json").read_text()) == read
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
-    assert report["step_reused"] == {"train_base_seed7": str(made)}
+    assert report["step_reused"] == {"train_base_seed7": str(made)} and report["step_data"] == read
     assert "- Reused: 1 training taken from first" in results.read_text()
 
     # another command or other data is another key (test_the_key_is_..., below): nothing is taken for it

@@ -21,12 +21,14 @@ logger = logging.getLogger(__name__)
 
 # step -> value records (times, commits) a run keeps beside its outputs
 REUSED_FILE = "step_reused.json"  # the trainings a table took from another (training_reuse)
+DATA_FILE = "step_data.json"  # the digest of the dataset each training read (training_reuse.dataset_digest)
 STEP_RECORDS = (
     "step_times.json",
     "step_cpu_times.json",
     "step_commits.json",
     "step_interrupted_times.json",
     REUSED_FILE,
+    DATA_FILE,
 )
 # the run's own settings, and the folders of its evaluation and rehearsal reports (JSON files in them):
 # what else the ledger keeps

@@ -164,6 +164,59 @@ def machine_line(result: dict) -> str:
     return f"- Machine: steps ran on {len(by_machine)} machines ({parts}; per step in the JSON)."
 
 
+def _seed_list(seeds: list[int]) -> str:
+    return f"seed{'' if len(seeds) == 1 else 's'} {', '.join(map(str, seeds))}"
+
+
+def _seeds_by(steps: dict[int, str], what: dict[str, str]) -> dict[str, list[int]]:
+    """``what`` of each seed's training step -> the seeds (a step with none recorded: "not recorded")."""
+    groups: dict[str, list[int]] = {}
+    for seed, step in steps.items():
+        groups.setdefault(what.get(step) or "not recorded", []).append(seed)
+    return groups
+
+
+def _grouped(groups: dict[str, list[int]]) -> str:
+    return "; ".join(f"{_seed_list(seeds)}: {value}" for value, seeds in groups.items())
+
+
+def seeds_made_apart_lines(result: dict) -> list[str]:
+    """Rows whose seeds were trained on other machines or other data: their mean mixes what made them.
+
+    A training is bit-identical only on one machine and one dataset (docs/results/reproducibility.md);
+    a table resumed on a new host trains its later seeds there, on data it made again. Data are
+    named by the digest of what training read (``step_data.json``), so data made again but equal
+    read as one.
+    """
+    machines = {step: (code or {}).get("machine") for step, code in (result.get("step_code") or {}).items()}
+    digests = {step: digest[:12] for step, digest in (result.get("step_data") or {}).items()}
+    lines = []
+    for row in result.get("rows", []):
+        if "seeds" not in row:  # a rehearsal's rows: one checkpoint each, made in its table
+            continue
+        steps = {seed["seed"]: f"train_{row['variant']}_seed{seed['seed']}" for seed in row["seeds"]}
+        by_machine, by_data = _seeds_by(steps, machines), _seeds_by(steps, digests)
+        if len(by_machine) == 1 and len(by_data) == 1:
+            continue
+        machine_part = (
+            f"trained on {len(by_machine)} machines ({_grouped(by_machine)})"
+            if len(by_machine) > 1
+            else f"trained on one machine ({next(iter(by_machine))})"
+        )
+        if len(by_data) == 1:
+            data = next(iter(by_data))
+            data_part = "data not recorded" if data == "not recorded" else f"the same data (digest {data})"
+        else:
+            data_part = f"{len(by_data)} datasets by digest ({_grouped(by_data)})"
+        lines.append(f"- {row['label']}: seeds {machine_part}, on {data_part}.")
+    if not lines:
+        return []
+    return [
+        "- Rows whose seeds were made apart (their mean mixes what made them; per step in the JSON):",
+        *(f"  {line}" for line in lines),
+    ]
+
+
 def cpu_line(result: dict) -> str:
     """The steps' CPU time: what they cost whatever else the machine ran beside them."""
     cpu = result.get("step_cpu_s") or {}
@@ -208,6 +261,7 @@ def provenance_lines(result: dict) -> list[str]:
     return [
         code_line(result),
         machine_line(result),
+        *seeds_made_apart_lines(result),
         f"- Wall time of this run: {result['wall_time_s'] / 60:.1f} min; all steps together, over every "
         f"(resumed) run: {sum(result['step_times_s'].values()) / 60:.1f} min{interrupted_part(result)}.",
         cpu_line(result),

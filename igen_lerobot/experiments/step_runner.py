@@ -22,9 +22,9 @@ from importlib.metadata import entry_points
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import IgenError
-from igen_lerobot.experiments.ledger import REUSED_FILE, Ledger
+from igen_lerobot.experiments.ledger import DATA_FILE, REUSED_FILE, Ledger
 from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
-from igen_lerobot.experiments.training_reuse import link_training, records_of_training
+from igen_lerobot.experiments.training_reuse import dataset_digest, link_training, records_of_training
 
 logger = logging.getLogger(__name__)
 
@@ -71,6 +71,10 @@ class StepRunner:
         # commit above are that training's, so the table's cost still reads as if made from scratch
         self.reused_file = self.out / REUSED_FILE
         self.reused: dict[str, str] = _read_json(self.reused_file, {})
+        # step -> digest of the dataset a training step read: a row's seeds trained in other sessions
+        # (another machine, data made again) show whether they read the same data or only the same recipe
+        self.data_file = self.out / DATA_FILE
+        self.data_digests: dict[str, str] = _read_json(self.data_file, {})
 
     def data(self, name: str) -> Path:
         return self.out / "data" / name
@@ -82,12 +86,14 @@ class StepRunner:
         done: Path,
         execute: list[str] | None = None,
         env: dict[str, str] | None = None,
+        reads: Path | None = None,
     ) -> None:
         """Run ``command`` unless ``done`` exists; its output is appended to ``logs/<name>.log``.
 
         ``execute``, when given, is what actually runs (a training resumed from its checkpoint),
         while ``command`` is what the table records: the command that makes the step from scratch.
         ``env``: variables the command runs with, recorded in front of it as a shell would take them.
+        ``reads``: the dataset a training step reads, whose digest is recorded when the step finishes.
         """
         env = env or {}
         shown = shell_command(command, env)
@@ -126,6 +132,7 @@ class StepRunner:
             self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
             self.versions[name] = step_code
             self.reused.pop(name, None)  # made here this time
+            self._record_data(name, reads)
             self._write_step_records()
             self.ledger.keep(done)
         if code != 0 or not done.exists():
@@ -133,7 +140,14 @@ class StepRunner:
             raise StepFailedError(f"step {name} failed (exit {code}): {shown}\nlog {log}:\n{tail}")
 
     def reuse(
-        self, name: str, command: list[str], done: Path, source: Path, output_dir: Path, env: dict[str, str]
+        self,
+        name: str,
+        command: list[str],
+        done: Path,
+        source: Path,
+        output_dir: Path,
+        env: dict[str, str],
+        reads: Path | None = None,
     ) -> None:
         """Take step ``name`` (a training into ``output_dir``) from ``source``, an identical finished training.
 
@@ -148,8 +162,15 @@ class StepRunner:
         for file, entry in records_of_training(source).items():
             own[file][name] = entry
         self.reused[name] = str(source)
+        self._record_data(name, reads)
         self._write_step_records()
         self.ledger.keep(done)
+
+    def _record_data(self, name: str, reads: Path | None) -> None:
+        if reads is not None:
+            self.data_digests[name] = dataset_digest(reads)
+        else:
+            self.data_digests.pop(name, None)  # made here this time, from no recorded dataset
 
     def _step_records(self) -> dict[str, dict]:
         """Each step-record file (``STEP_RECORDS``) and the dict this runner keeps of it."""
@@ -159,6 +180,7 @@ class StepRunner:
             "step_commits.json": self.versions,
             "step_interrupted_times.json": self.interrupted,
             REUSED_FILE: self.reused,
+            DATA_FILE: self.data_digests,
         }
 
     def _write_step_records(self) -> None:
@@ -183,6 +205,9 @@ class StepRunner:
             "step_cpu_s": {step: t for step, t in self.cpu_times.items() if step in ran},
             "step_interrupted_s": {step: t for step, t in self.interrupted.items() if step in ran},
         }
+        data = {step: digest for step, digest in self.data_digests.items() if step in ran}
+        if data:
+            record["step_data"] = data
         reused = {step: source for step, source in self.reused.items() if step in ran}
         if reused:
             record["step_reused"] = reused

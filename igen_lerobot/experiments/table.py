@@ -262,9 +262,9 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
         key = training_key(command, env, dataset, out)
         source = find_identical_training(run.out.parent, key, out, cfg.steps)
     if source is not None:
-        run.reuse(name, command, done, source, out, env)
+        run.reuse(name, command, done, source, out, env, reads=dataset)
     else:
-        run.run(name, command, done, execute, env=env)
+        run.run(name, command, done, execute, env=env, reads=dataset)
     if not run.dry_run and (final / "config.json").exists() and not (out / KEY_FILE).exists():
         # marked for a sibling table that would train the same (also a training finished before keys were)
         write_key(out, key or training_key(command, env, dataset, out), source)
