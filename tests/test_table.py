@@ -206,6 +206,26 @@ def test_a_training_step_records_the_digest_of_the_data_it_read_and_the_ledger_k
     assert runner.data_digests["train_base_seed1"] != recorded["train_base_seed1"]
 
 
+def test_a_training_made_before_data_were_recorded_counts_its_data_only_if_they_were_not_made_again(tmp_path):
+    from igen_lerobot.experiments.training_reuse import read_as_it_is
+
+    dataset, training = tmp_path / "data" / "base", tmp_path / "train" / "base" / "seed1"
+    marker = dataset / "meta" / "igen.json"
+    marker.parent.mkdir(parents=True)
+    assert not read_as_it_is(dataset, training)  # an incomplete dataset, no training
+    marker.write_text("{}")
+    assert not read_as_it_is(dataset, training)  # no checkpoint: nothing was read here
+    for step, when in (("000001", 2000.0), ("000002", 3000.0)):
+        config = training / "checkpoints" / step / "pretrained_model" / "config.json"
+        config.parent.mkdir(parents=True)
+        config.write_text("{}")
+        os.utime(config, (when, when))
+    os.utime(marker, (1000.0, 1000.0))
+    assert read_as_it_is(dataset, training)  # made before the training's first checkpoint
+    os.utime(marker, (2500.0, 2500.0))
+    assert not read_as_it_is(dataset, training)  # made again after the training began
+
+
 def test_the_page_names_rows_whose_seeds_were_trained_on_other_machines_or_other_data():
     from igen_lerobot.experiments.provenance import seeds_made_apart_lines
 

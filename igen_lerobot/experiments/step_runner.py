@@ -123,7 +123,7 @@ class StepRunner:
                         ).returncode
         except KeyboardInterrupt:
             self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
-            self._write_step_records()
+            self.write_step_records()
             logger.info("%s: stopped; rerun to resume it", name)
             raise
         if code == 0 and done.exists():
@@ -132,8 +132,8 @@ class StepRunner:
             self.cpu_times[name] = self.cpu_times.get(name, 0.0) + cpu_seconds() - cpu_start
             self.versions[name] = step_code
             self.reused.pop(name, None)  # made here this time
-            self._record_data(name, reads)
-            self._write_step_records()
+            self.record_data(name, reads)
+            self.write_step_records()
             self.ledger.keep(done)
         if code != 0 or not done.exists():
             tail = log.read_text()[-1500:]
@@ -162,11 +162,12 @@ class StepRunner:
         for file, entry in records_of_training(source).items():
             own[file][name] = entry
         self.reused[name] = str(source)
-        self._record_data(name, reads)
-        self._write_step_records()
+        self.record_data(name, reads)
+        self.write_step_records()
         self.ledger.keep(done)
 
-    def _record_data(self, name: str, reads: Path | None) -> None:
+    def record_data(self, name: str, reads: Path | None) -> None:
+        """Record the digest of the dataset step ``name`` read (``reads`` None: a step made from no dataset)."""
         if reads is not None:
             self.data_digests[name] = dataset_digest(reads)
         else:
@@ -183,7 +184,7 @@ class StepRunner:
             DATA_FILE: self.data_digests,
         }
 
-    def _write_step_records(self) -> None:
+    def write_step_records(self) -> None:
         self.out.mkdir(parents=True, exist_ok=True)
         for file, entries in self._step_records().items():
             (self.out / file).write_text(json.dumps(entries, indent=2))

@@ -56,6 +56,7 @@ from igen_lerobot.experiments.table_steps import (
 from igen_lerobot.experiments.training_reuse import (
     KEY_FILE,
     find_identical_training,
+    read_as_it_is,
     training_key,
     write_key,
 )
@@ -268,6 +269,9 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     if not run.dry_run and (final / "config.json").exists() and not (out / KEY_FILE).exists():
         # marked for a sibling table that would train the same (also a training finished before keys were)
         write_key(out, key or training_key(command, env, dataset, out), source)
+    if not run.dry_run and name not in run.data_digests and read_as_it_is(dataset, out):
+        run.record_data(name, dataset)  # a training finished before data were recorded
+        run.write_step_records()
     return final
 
 

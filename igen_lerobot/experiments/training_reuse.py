@@ -77,6 +77,18 @@ def training_key(command: list[str], env: dict[str, str], dataset: Path, output_
     return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()
 
 
+def read_as_it_is(dataset: Path, training: Path) -> bool:
+    """Whether the finished ``training`` read ``dataset`` as it is on disk now.
+
+    For a training made before the table recorded what data each read: a dataset is written once and
+    its completion marker (``meta/igen.json``) last, so a marker older than the training's first
+    checkpoint means the data have not been made again since the training began reading them.
+    """
+    marker = Path(dataset) / IGEN_META_FILE
+    saved = [p.stat().st_mtime for p in Path(training).glob("checkpoints/*/pretrained_model/config.json")]
+    return marker.exists() and bool(saved) and marker.stat().st_mtime < min(saved)
+
+
 def write_key(output_dir: Path, key: str, reused_from: Path | None = None) -> None:
     """Mark a finished training with its key, so that a sibling table can find it."""
     record = {"key": key, **({"reused_from": str(reused_from)} if reused_from is not None else {})}
