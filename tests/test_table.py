@@ -34,10 +34,13 @@ def test_reduced_table_builds_trains_evaluates_and_resumes(tmp_path, tiny_table)
     from lerobot_env_igen.block_grasp.spec import SPEC
 
     out, results = tmp_path / "table", tmp_path / "results.md"
-    first = tiny_table(out, results, "--generated=3", "--train_seeds=[7]", timeout=360)
+    first = tiny_table(out, results, "--generated=3", "--train_seeds=[7]", "--run_first=[igen]", timeout=360)
     assert first.returncode == 0, first.stderr[-4000:]
 
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
+    # I-Gen was made first; its row keeps its place (and the resume below, without --run_first, is allowed)
+    validations = [c["step"] for c in report["commands"] if c["step"].startswith("validate_")]
+    assert validations[0] == "validate_igen_seed7" and len(validations) == len(VARIANTS)
     assert [row["variant"] for row in report["rows"]] == list(VARIANTS)
     markdown = results.read_text()
     for row in report["rows"]:
@@ -288,6 +291,9 @@ def test_a_resumed_table_refuses_settings_that_change_finished_steps(tmp_path):
         check_resumed_config(TableConfig(output_dir=out, n_trials=20))
     with pytest.raises(ConfigError, match="first seed trains the policy"):
         check_resumed_config(TableConfig(output_dir=out, train_seeds=[5, 1000]))
+    check_resumed_config(TableConfig(output_dir=out, variants=["base", "igen"], run_first=["igen"]))
+    with pytest.raises(ConfigError, match=r"--run_first must list distinct rows of this table"):
+        TableConfig(variants=["base", "igen"], run_first=["mg_demo"])
 
 
 def test_table_config_refuses_seeds_that_break_the_protocol():

@@ -19,7 +19,7 @@ TEST_SEED = 2_000_003  # trials no choice is ever made on: the published rates
 
 # config fields added after tables were published that change no number (where records are kept,
 # whether weights are made again): a published config without them is still whole
-NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings", "rehearse", "rehearsal")
+NUMBER_NEUTRAL_FIELDS = ("ledger_dir", "retrain_restored", "reuse_trainings", "rehearse", "rehearsal", "run_first")
 # config fields added after tables were published that do change numbers, with the value every table
 # made before them had: a config without one was made that way (and resumes only that way)
 EARLIER_VALUES = {"observation_stats": "own"}
@@ -78,6 +78,9 @@ class TableConfig:
     reveal: str | None = None  # e.g. contact_position for the paper's partial-observability table
     table: str = ""  # a named paper table of the task (e.g. scaling); "" is the table of the reveal mode
     variants: list[str] | None = None  # default: the rows of the paper's table for this task and reveal mode
+    # rows made before the others, each keeping its place in the table: the row a long table is waited on
+    # for (the randomised Block Grasp table's I-Gen, whose rehearsal is the sim-to-real goal)
+    run_first: list[str] = field(default_factory=list)
     source_episodes: int = 10  # human (here: scripted-operator) episodes of each kind
     base_demos: int = 1000  # MimicGen demonstrations forming the base dataset D
     generated: int = 1000  # synthetic episodes for MG Demo, I-Gen - Policy and I-Gen
@@ -141,6 +144,11 @@ class TableConfig:
                 f"--variants must be a non-empty list of {list(VARIANTS)}{own} or sized rows igen_<n> / "
                 f"source_int_<n>, got {self.variants}"
             )
+        stray = [v for v in self.run_first if v not in self.variants]
+        if stray or len(set(self.run_first)) != len(self.run_first):
+            raise ConfigError(
+                f"--run_first must list distinct rows of this table ({self.variants}), got {self.run_first}"
+            )
         if self.train_seeds is None:
             self.train_seeds = [self.train.seed + i for i in range(3)]
         if not self.train_seeds or len(set(self.train_seeds)) != len(self.train_seeds):
@@ -168,6 +176,10 @@ class TableConfig:
         check_observation_stats(self.observation_stats, self.train.policy_type)
         if not self.results.endswith(".md"):
             raise ConfigError(f"--results must name a markdown file (.md), got {self.results!r}")
+
+    def running_order(self) -> list[str]:
+        """The rows in the order they are made: ``run_first``, then the others in the table's order."""
+        return [*self.run_first, *(v for v in self.variants if v not in self.run_first)]
 
     def env_config(self) -> TaskEnvConfig:
         """The task's config under this table's reveal mode (checked: a clear error for a bad one)."""

@@ -86,6 +86,7 @@ RESUMABLE_CHANGES = (
     "reuse_trainings",
     "rehearse",
     "rehearsal",
+    "run_first",
 )
 
 
@@ -406,7 +407,7 @@ def plan(cfg: TableConfig) -> list[dict]:
     run = TableRun(replace(cfg, dry_run=True))
     datasets = build_datasets(run)
     rehearsal = TableRehearsal(run, cfg) if cfg.rehearse else None
-    for variant in cfg.variants:
+    for variant in cfg.running_order():
         for seed in cfg.train_seeds:
             train(run, variant, datasets[variant], seed)
             evaluate_seed(run, variant, seed)
@@ -428,26 +429,24 @@ def run_table(cfg: TableConfig) -> dict:
     paper = cfg.paper_table()
     datasets = build_datasets(run)
     rehearsal = TableRehearsal(run, cfg) if cfg.rehearse else None
-    rows = []
-    for variant in cfg.variants:
+    rows = {}
+    for variant in cfg.running_order():
         seeds = []
         for seed in cfg.train_seeds:
             train(run, variant, datasets[variant], seed)
             seeds.append(evaluate_seed(run, variant, seed))
             if rehearsal is not None:
                 rehearsal.rehearse(variant, seed)
-        rows.append(
-            summarise_row(
-                variant,
-                seeds,
-                None if paper is None else paper.paper_success(variant, run.choose_on or None),
-                _dataset_size(datasets[variant]),
-                label=variant_label(variant, run.derived),
-                paper_columns={c: paper.paper_success(variant, c) for c in run.columns},
-            )
+        rows[variant] = summarise_row(
+            variant,
+            seeds,
+            None if paper is None else paper.paper_success(variant, run.choose_on or None),
+            _dataset_size(datasets[variant]),
+            label=variant_label(variant, run.derived),
+            paper_columns={c: paper.paper_success(variant, c) for c in run.columns},
         )
         if not trains_with_base(variant, run.derived):
-            rows[-1]["without_base"] = True  # trained on its own data alone, not D plus it
+            rows[variant]["without_base"] = True  # trained on its own data alone, not D plus it
     results = Path(cfg.results)
     folder = results_folder(results)
     folder.mkdir(parents=True, exist_ok=True)
@@ -457,7 +456,7 @@ def run_table(cfg: TableConfig) -> dict:
         "reveal": env.reveal.value,
         **({"columns": run.columns, "choose_on": run.choose_on} if run.columns else {}),
         "config": asdict(cfg),
-        "rows": rows,
+        "rows": [rows[variant] for variant in cfg.variants],  # the table's order, whatever ran first
         **run.record(start, folder / f"{cfg.name}.json"),
     }
     (folder / f"{cfg.name}.json").write_text(json.dumps(result, indent=2))
