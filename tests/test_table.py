@@ -229,6 +229,23 @@ def test_a_training_made_before_data_were_recorded_counts_its_data_only_if_they_
     assert not read_as_it_is(dataset, training)  # made again after the training began
 
 
+def test_a_validation_names_the_data_of_the_weights_it_read_only_when_made_on_the_trainings_machine(tmp_path):
+    from igen_lerobot.experiments.table import TableRun, carry_data_record
+
+    run = TableRun(TableConfig(output_dir=str(tmp_path / "t"), variants=["base"]))
+    here, there = {"commit": "a" * 40, "machine": "CPU avx2"}, {"commit": "a" * 40, "machine": "CPU avx512f"}
+    run.versions.update(train_base_seed1=here, validate_base_seed1=here, train_base_seed2=here)
+    run.versions["validate_base_seed2"] = there  # restored from the ledger: another machine's weights
+    run.data_digests.update(train_base_seed1="d" * 64, train_base_seed2="e" * 64)
+    carry_data_record(run, "validate_base_seed1", "train_base_seed1")
+    carry_data_record(run, "validate_base_seed2", "train_base_seed2")
+    assert run.data_digests["validate_base_seed1"] == "d" * 64 and "validate_base_seed2" not in run.data_digests
+    assert json.loads((tmp_path / "t" / "step_data.json").read_text())["validate_base_seed1"] == "d" * 64
+    run.data_digests["train_base_seed1"] = "f" * 64  # trained again later: the validation keeps its own
+    carry_data_record(run, "validate_base_seed1", "train_base_seed1")
+    assert run.data_digests["validate_base_seed1"] == "d" * 64
+
+
 def test_the_page_names_rows_whose_seeds_were_trained_on_other_machines_or_other_data():
     from igen_lerobot.experiments.provenance import seeds_made_apart_lines
 
@@ -239,12 +256,14 @@ def test_the_page_names_rows_whose_seeds_were_trained_on_other_machines_or_other
     result = {
         "rows": [row("base", [1, 2]), row("mg", [1, 2, 3]), row("igen", [1, 2])],
         "step_code": {
-            "train_base_seed1": here, "train_base_seed2": here,
-            "train_mg_seed1": there, "train_mg_seed2": there, "train_mg_seed3": here,
-            "train_igen_seed1": here, "train_igen_seed2": here,
+            "validate_base_seed1": here, "validate_base_seed2": here,
+            "validate_mg_seed1": there, "validate_mg_seed2": there, "validate_mg_seed3": here,
+            "validate_igen_seed1": here, "validate_igen_seed2": here,
+            "train_base_seed1": there,  # made again on another machine after its weights were evaluated
         },
-        "step_data": {"train_base_seed1": "d" * 64, "train_base_seed2": "d" * 64, "train_mg_seed3": "e" * 64,
-                      "train_igen_seed1": "d" * 64, "train_igen_seed2": "f" * 64},
+        "step_data": {"validate_base_seed1": "d" * 64, "validate_base_seed2": "d" * 64,
+                      "validate_mg_seed3": "e" * 64, "validate_igen_seed1": "d" * 64,
+                      "validate_igen_seed2": "f" * 64, "train_base_seed1": "0" * 64},
     }  # fmt: skip
     lines = seeds_made_apart_lines(result)
     assert lines[0].startswith("- Rows whose seeds were made apart")

@@ -35,7 +35,8 @@ def test_a_sibling_tables_identical_training_is_linked_in_and_evaluated_anew(tmp
         assert taken_records["train_base_seed7"] == made_records["train_base_seed7"]
         assert {"validate_base_seed7", "test_base_seed7"} <= taken_records.keys()
     # both read the same data, and each says so by its digest
-    read = {"train_base_seed7": dataset_digest(tables / "first" / "data" / "base")}
+    digest = dataset_digest(tables / "first" / "data" / "base")
+    read = {"train_base_seed7": digest, "validate_base_seed7": digest}
     assert json.loads((tables / "first" / "step_data.json").read_text()) == read
     assert json.loads((tables / "second" / "step_data.json").read_text()) == read
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())

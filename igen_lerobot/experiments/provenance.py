@@ -184,9 +184,9 @@ def seeds_made_apart_lines(result: dict) -> list[str]:
     """Rows whose seeds were trained on other machines or other data: their mean mixes what made them.
 
     A training is bit-identical only on one machine and one dataset (docs/results/reproducibility.md);
-    a table resumed on a new host trains its later seeds there, on data it made again. Data are
-    named by the digest of what training read (``step_data.json``), so data made again but equal
-    read as one.
+    a table resumed on a new host trains its later seeds there, on data it made again. A seed is
+    named by its validation step: the machine that read the weights, and the digest of the data those
+    weights were trained on (``step_data.json``), so data made again but equal read as one.
     """
     machines = {step: (code or {}).get("machine") for step, code in (result.get("step_code") or {}).items()}
     digests = {step: digest[:12] for step, digest in (result.get("step_data") or {}).items()}
@@ -194,7 +194,8 @@ def seeds_made_apart_lines(result: dict) -> list[str]:
     for row in result.get("rows", []):
         if "seeds" not in row:  # a rehearsal's rows: one checkpoint each, made in its table
             continue
-        steps = {seed["seed"]: f"train_{row['variant']}_seed{seed['seed']}" for seed in row["seeds"]}
+        # each seed by its validation step, which read the weights its numbers rest on (table.carry_data_record)
+        steps = {seed["seed"]: f"validate_{row['variant']}_seed{seed['seed']}" for seed in row["seeds"]}
         by_machine, by_data = _seeds_by(steps, machines), _seeds_by(steps, digests)
         if len(by_machine) == 1 and len(by_data) == 1:
             continue

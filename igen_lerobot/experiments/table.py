@@ -276,6 +276,22 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     return final
 
 
+def carry_data_record(run: TableRun, validation: str, training: str) -> None:
+    """Name, on the validation step, the data the weights it read were trained on.
+
+    The weights a seed's numbers rest on are those its validation read; a training made again later
+    (the base policy on a new machine, which generation needs) records its own data, not theirs. The
+    training's record is theirs when both steps ran on one machine (deterministic training: the same
+    weights from the same data) and the validation holds none of its own.
+    """
+    if run.dry_run or validation in run.data_digests or training not in run.data_digests:
+        return
+    machine = (run.versions.get(validation) or {}).get("machine")
+    if machine is not None and machine == (run.versions.get(training) or {}).get("machine"):
+        run.data_digests[validation] = run.data_digests[training]
+        run.write_step_records()
+
+
 def _eval(run: TableRun, name: str, report: Path, target: list[str], n_trials: int, seed: int) -> dict:
     cfg = run.cfg
     run.run(
@@ -314,6 +330,7 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
         cfg.n_val_trials,
         cfg.val_seed,
     )
+    carry_data_record(run, f"validate_{variant}_seed{seed}", f"train_{variant}_seed{seed}")
     # a dry run has no trials to choose on: its plan shows the last checkpoint
     chosen = None if cfg.dry_run else chosen_result(validation)
     step = cfg.train.steps if chosen is None else chosen.step
