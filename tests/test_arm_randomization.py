@@ -103,6 +103,34 @@ def test_observed_hand_position_carries_the_configured_noise():
     assert 0.0015 < std < 0.0025, std  # 300 samples: the std within 25% of 2 mm
 
 
+def test_observed_object_orientation_carries_the_configured_noise_and_leaves_the_hands_alone():
+    from scipy.spatial.transform import Rotation
+
+    from igen_lerobot.core.task import OBS_ENV_STATE
+
+    env = block_grasp(eef_pos_noise=0.002, object_rot_noise_deg=1.0).make_task_env()
+    hand_only = block_grasp(eef_pos_noise=0.002).make_task_env()
+    env.reset(2)
+    hand_only.reset(2)
+    angles, position_errors = [], []
+    for _ in range(100):
+        for e in (env, hand_only):
+            e.step(np.array([0.0, 0.0, 0.0, -1.0]))
+        observed, plain = env.observe(), hand_only.observe()
+        # the hand's noise is drawn from its own stream: the same with or without the objects' noise
+        np.testing.assert_array_equal(observed[OBS_STATE], plain[OBS_STATE])
+        cube = observed[OBS_ENV_STATE][:7]
+        truth = env.believed_object_poses()["cube"]
+        position_errors.append(cube[:3] - truth[:3, 3])
+        error = Rotation.from_quat(cube[3:7]) * Rotation.from_matrix(truth[:3, :3]).inv()
+        angles.append(error.as_rotvec())
+    np.testing.assert_allclose(position_errors, 0.0, atol=1e-6)  # orientation only (float32 observations)
+    std_deg = float(np.degrees(np.std(angles)))
+    assert 0.75 < std_deg < 1.25, std_deg  # 300 samples: the std within 25% of 1 deg per axis
+    assert env.randomization.describe()["object_rot_noise_deg"] == 1.0
+    assert "object_rot_noise_deg" not in hand_only.randomization.describe()
+
+
 @pytest.mark.parametrize(
     "randomize, message",
     [
@@ -111,6 +139,8 @@ def test_observed_hand_position_carries_the_configured_noise():
         ({"latency": (0.0, 0.05)}, "env.randomize.latency"),
         ({"hand_tilt_deg": 30.0}, "env.randomize.hand_tilt_deg"),
         ({"eef_pos_noise": -1.0}, "env.randomize.eef_pos_noise"),
+        ({"object_rot_noise_deg": -1.0}, "env.randomize.object_rot_noise_deg"),
+        ({"object_rot_noise_deg": 20.0}, "env.randomize.object_rot_noise_deg"),
     ],
 )
 def test_bad_ranges_are_refused_by_their_flag(randomize, message):
@@ -138,6 +168,7 @@ def test_igen_collect_records_the_randomisation_and_the_card_says_it(tmp_path):
         "--seed=3",
         "--env.randomize.kp_scale=[0.6,1.4]",
         "--env.randomize.latency=[0,0.03]",
+        "--env.randomize.object_rot_noise_deg=1",
         f"--dataset.root={tmp_path / 'demos'}",
         "--dataset.repo_id=local/randomised",
     ]
@@ -152,7 +183,7 @@ def test_igen_collect_records_the_randomisation_and_the_card_says_it(tmp_path):
     info = json.loads((tmp_path / "demos" / "meta" / "info.json").read_text())
     body = card_fields(tmp_path / "demos", spec, info, meta)["dataset_description"]
     said = "randomised per episode from its seed: controller stiffness x[0.6, 1.4], action latency [0.0, 0.03] s"
-    assert said in body
+    assert said in body and "object-orientation observation noise 1.0 deg (std per axis)" in body
     plain = {**meta, "origin": {k: v for k, v in meta["origin"].items() if k != "randomization"}}
     unrandomised = card_fields(tmp_path / "demos", spec, info, plain)["dataset_description"]
     assert "same in every episode (no dynamics randomisation)" in unrandomised

@@ -89,6 +89,7 @@ def _randomization_text(origin: dict) -> str:
         "latency_s": "action latency {} s",
         "hand_tilt_deg": "hand tilt up to {} deg",
         "eef_pos_noise_m": "hand-position observation noise {} m (std)",
+        "object_rot_noise_deg": "object-orientation observation noise {} deg (std per axis)",
     }
     parts = [text.format(randomization[key]) for key, text in said.items() if key in randomization]
     return f" The arm was randomised per episode from its seed: {', '.join(parts)}."

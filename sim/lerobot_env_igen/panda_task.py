@@ -23,7 +23,7 @@ import numpy as np
 from igen_lerobot.core.belief import ObjectBelief, Reveal
 from igen_lerobot.core.observation import observation
 from igen_lerobot.core.task import StepInfo, TaskEnv
-from lerobot_env_igen.arm_randomization import NO_DRAW, ArmDraw
+from lerobot_env_igen.arm_randomization import NO_DRAW, ArmDraw, rotation_noise
 from lerobot_env_igen.cameras import PANDA_CAMERAS
 from lerobot_env_igen.panda import TOP_DOWN_ROT, ContactEvent, PandaArm
 from lerobot_env_igen.panda_spec import GRIPPER
@@ -57,6 +57,7 @@ class PandaTaskEnv(TaskEnv):
         self.randomization = config.randomize
         self.arm_draw: ArmDraw = NO_DRAW  # this episode's arm (reset draws it from the seed)
         self._obs_noise: np.random.Generator | None = None
+        self._object_noise: np.random.Generator | None = None
         self.max_delta = float(config.max_delta)
         model, default_qpos = build_panda_table_scene(objects)
         home = np.asarray(home_pos, dtype=float)
@@ -188,6 +189,8 @@ class PandaTaskEnv(TaskEnv):
         self.arm_draw = draw
         self.arm.set_dynamics(draw.kp_scale, draw.latency)
         self._obs_noise = np.random.default_rng(draw.noise_seed) if draw.eef_pos_noise else None
+        # a stream of its own: the hand's noise stays what it was without the objects'
+        self._object_noise = np.random.default_rng((draw.noise_seed, 1)) if draw.object_rot_noise else None
 
     def step(self, action: np.ndarray) -> StepInfo:
         action = self.action_space.checked(action, self.spec.name)
@@ -234,7 +237,12 @@ class PandaTaskEnv(TaskEnv):
         T_world_eef = self.eef_pose()
         if self._obs_noise is not None:  # the policy sees the hand where a noisy estimate puts it
             T_world_eef[:3, 3] += self._obs_noise.normal(0.0, self.arm_draw.eef_pos_noise, 3)
-        return observation(self.spec, T_world_eef, self.gripper_width(), self.believed_object_poses(), self.belief)
+        poses = self.believed_object_poses()
+        if self._object_noise is not None:  # the policy sees the objects turned as a camera's estimate turns them
+            for name in self.spec.objects:
+                turn = rotation_noise(self._object_noise, self.arm_draw.object_rot_noise)
+                poses[name][:3, :3] = turn @ poses[name][:3, :3]
+        return observation(self.spec, T_world_eef, self.gripper_width(), poses, self.belief)
 
     def true_object_poses(self) -> dict[str, np.ndarray]:
         return {name: self.body_pose(body) for name, body in self.bodies.items()}
