@@ -1,10 +1,11 @@
 """Per-episode randomisation of what a deployed arm changes (``--env.randomize.*``), off by default.
 
 A policy trained on one simulated arm learns that arm's quirks: how fast it answers a new goal, how
-late, how its hand is tilted, how exactly its pose and the objects' poses are known. A real Franka differs in each, so
-generation can randomise them, as domain randomisation does: every episode draws its own values
-from its seed, from a random stream of its own, so turning randomisation off (the default) leaves
-every scene, error and rollout bit-identical to a run without it. The draw is recorded in the
+late, how its hand is tilted, how exactly its pose and the objects' poses are known. A real Franka
+and its camera differ in each, so generation can randomise them, as domain randomisation does:
+every episode draws its own values from its seed, from a random stream of its own, so turning
+randomisation off (the default) leaves every scene, error and rollout bit-identical to a run
+without it. The draw is recorded in the
 dataset's ``meta/igen.json`` (``origin.randomization``) and said on its card.
 """
 
