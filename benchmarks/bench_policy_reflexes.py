@@ -40,6 +40,7 @@ def main() -> None:
     import torch
 
     from igen_lerobot.core.belief import Reveal
+    from igen_lerobot.core.seeding import episode_seed
     from igen_lerobot.training.policy_source import PolicySourceConfig, make_base_policy
     from lerobot_env_igen.block_grasp.config import BlockGraspEnvConfig
     from lerobot_robot_igen.arm.config_franky_arm import FrankyArmConfig
@@ -60,8 +61,10 @@ def main() -> None:
 
     torch.set_num_threads(1)
     env_cfg = BlockGraspEnvConfig()
-    policy = make_base_policy(PolicySourceConfig(path=args.checkpoint), env_cfg)
-    deploy_cfg = DeployConfig(trials=args.trials, max_steps=args.max_steps)
+    source = PolicySourceConfig(path=args.checkpoint)
+    policy = make_base_policy(source, env_cfg)
+    # the policy path lets --hand_orientation=auto read the training data, as igen-deploy does
+    deploy_cfg = DeployConfig(policy=source, trials=args.trials, max_steps=args.max_steps)
     situations = _trial_situations(env_cfg, deploy_cfg)
     host = "127.0.0.1"  # franka-sim's fixed address
     server = start_server("franka-sim", args.python, host)
@@ -85,7 +88,8 @@ def main() -> None:
                     cube_belief(offset, Reveal.FULL),
                     replace(loop_settings(deploy_cfg, goal), realtime=True),
                     judge=lambda state, action: False,
-                    spec=env_cfg.task_spec,
+                    task=env_cfg,
+                    seed=episode_seed(deploy_cfg.seed, i),
                 )
                 results.append(
                     {
