@@ -5,8 +5,8 @@ late, how its hand is tilted, how exactly its pose and the objects' poses are kn
 and its camera differ in each, so generation can randomise them, as domain randomisation does:
 every episode draws its own values from its seed, from a random stream of its own, so turning
 randomisation off (the default) leaves every scene, error and rollout bit-identical to a run
-without it. The draw is recorded in the
-dataset's ``meta/igen.json`` (``origin.randomization``) and said on its card.
+without it. The draw is recorded in the dataset's ``meta/igen.json`` (``origin.randomization``) and
+said on its card.
 """
 
 from __future__ import annotations
