@@ -116,6 +116,42 @@ def test_a_bridge_that_turns_further_takes_more_steps(clean_env):
     assert rotation_angle(env.eef_pose()[:3, :3], turned[:3, :3]) < 1e-9
 
 
+@pytest.mark.parametrize(
+    ("recorded", "frames", "bridge_closed"),
+    [
+        ([False, True, True, True], 3, True),  # a one-frame open at a policy's first step is not held
+        ([True, False, False, False], 3, False),  # nor a one-frame close
+        ([False, False, True, True], 3, False),  # a command held from the start is
+        ([False, True], 3, False),  # a tie: the first frame's
+        ([False, True, True, True], 1, False),  # MimicGen's rule: the first frame's, whatever follows
+    ],
+)
+def test_the_bridge_holds_the_command_the_segment_settles_on(clean_env, recorded, frames, bridge_closed):
+    env = clean_env
+    obs = env.reset(0)
+    start = env.eef_pose()
+    away = make_pose(start[:3, 3] + [0.1, 0.0, 0.0], start[:3, :3])
+    segment = SourceSegment(
+        episode=0,
+        subtask=0,
+        role=SegmentRole.SUBTASK,
+        object_name="block",
+        T_world_obj=env.true_object_poses()["block"],
+        eef=np.repeat(away[None], len(recorded), axis=0),
+        targets=np.repeat(away[None], len(recorded), axis=0),
+        gripper_closed=np.array(recorded),
+        corruption=np.zeros(3),
+    )
+    cfg = ReplayConfig(interpolation_steps=5, interpolation_speed=0.015, hold_steps=0, bridge_gripper_frames=frames)
+    recorder = EpisodeRecorder(env)
+    outcome = replay_segment(env, recorder, obs, segment, cfg, np.random.default_rng(0), False, 100)
+    bridge = len(outcome.interpolation)
+    assert bridge == 7  # 10 cm at 1.5 cm per step
+    commands = [env.gripper_command(action) for action in recorder.action]
+    assert commands[:bridge] == [bridge_closed] * bridge
+    assert commands[bridge:] == recorded  # the segment itself replays every recorded command, blips included
+
+
 def test_target_noise_perturbs_orientation_as_well_as_position():
     goal = make_pose([0.1, 0.2, 0.3], rot_z(0.4))
     rng = np.random.default_rng(0)
@@ -134,6 +170,7 @@ def test_target_noise_perturbs_orientation_as_well_as_position():
         ("target_noise", -0.1),
         ("target_rotation_noise", -1.0),
         ("hold_steps", -1),
+        ("bridge_gripper_frames", 0),
         ("interpolation_steps", 0),
         ("interpolation_speed", 0.0),
         ("interpolation_rotation_speed", 0.0),

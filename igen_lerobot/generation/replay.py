@@ -5,6 +5,12 @@ the object (``T_new_eef = T_new_obj · inv(T_src_obj) · T_src_eef``), bridge fr
 robot is to the first transformed goal with a linear/slerp interpolation, then execute the
 goals one per control step with the recorded gripper commands.
 
+The bridge holds the gripper command the segment settles on over its first frames, not its first
+frame's alone: a recorded policy can issue a one-frame command at a hidden-state reset (BC-RNN at
+its first step), which the source's hand never followed; held over a bridge of several steps it
+would open the hand and drop a held part the source kept (the "I-Gen − Policy" ablation replays such
+policy segments).
+
 The bridge is long enough for both its distance and its rotation; target noise (MimicGen's
 action noise) perturbs positions and orientations; a segment that ends before its subtask is
 done holds its last goal for a few steps, but never once the subtask is done, so a multi-stage
@@ -34,6 +40,7 @@ class ReplayConfig:
     target_noise: float = 0.0  # [m] std of Gaussian noise on replayed goal positions (MimicGen's action noise)
     target_rotation_noise: float = 0.0  # [rad] std of the noise rotation on replayed goal orientations
     hold_steps: int = 10  # extra steps holding the last goal while the segment's subtask is not done yet
+    bridge_gripper_frames: int = 3  # the bridge holds the majority command of the segment's first N (1: the first's)
 
     def __post_init__(self) -> None:
         if self.interpolation_steps < 1:
@@ -49,12 +56,21 @@ class ReplayConfig:
             raise ConfigError(f"replay.target_rotation_noise must be >= 0 [rad], got {self.target_rotation_noise}")
         if self.hold_steps < 0:
             raise ConfigError(f"replay.hold_steps must be >= 0, got {self.hold_steps}")
+        if self.bridge_gripper_frames < 1:
+            raise ConfigError(f"replay.bridge_gripper_frames must be >= 1, got {self.bridge_gripper_frames}")
 
     def bridge_steps(self, distance: float, angle: float = 0.0) -> int:
         """Steps for a bridge of ``distance`` [m] turning by ``angle`` [rad]: at least ``interpolation_steps``."""
         by_distance = int(np.ceil(distance / self.interpolation_speed))
         by_angle = int(np.ceil(angle / self.interpolation_rotation_speed))
         return max(self.interpolation_steps, by_distance, by_angle)
+
+    def bridge_gripper(self, gripper_closed: np.ndarray) -> bool:
+        """The command the bridge holds: the majority of the segment's first frames (a tie: the first's)."""
+        head = np.asarray(gripper_closed[: self.bridge_gripper_frames], dtype=bool)
+        closed = int(np.count_nonzero(head))
+        opened = len(head) - closed
+        return bool(head[0]) if closed == opened else closed > opened
 
     def perturb(self, goal: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """``goal`` with this config's position and orientation noise (unchanged when both are 0)."""
@@ -108,7 +124,7 @@ def replay_segment(
     goals = np.concatenate([bridge, transformed, hold])
     gripper = np.concatenate(
         [
-            np.full(len(bridge), segment.gripper_closed[0]),
+            np.full(len(bridge), cfg.bridge_gripper(segment.gripper_closed)),
             segment.gripper_closed,
             np.full(len(hold), segment.gripper_closed[-1]),
         ]
