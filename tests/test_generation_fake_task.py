@@ -94,22 +94,28 @@ def test_intervengen_replays_a_recovery_into_the_blocks_true_frame_after_the_pol
     assert kept and all(ep.kind == "igen_no_policy" and not (ep.source == FrameSource.POLICY).any() for ep in kept)
 
 
-def test_a_bridge_that_turns_further_takes_more_steps(clean_env):
-    env = clean_env
-    obs = env.reset(0)
-    start = env.eef_pose()
-    turned = make_pose(start[:3, 3], rot_z(np.pi / 2) @ start[:3, :3])
-    segment = SourceSegment(
+def _held_goal_segment(env, goal, gripper_closed: list[bool]) -> SourceSegment:
+    """A first-subtask segment that holds one end-effector goal, one frame per recorded gripper command."""
+    goals = np.repeat(goal[None], len(gripper_closed), axis=0)
+    return SourceSegment(
         episode=0,
         subtask=0,
         role=SegmentRole.SUBTASK,
         object_name="block",
         T_world_obj=env.true_object_poses()["block"],
-        eef=turned[None],
-        targets=turned[None],
-        gripper_closed=np.array([False]),
+        eef=goals,
+        targets=goals,
+        gripper_closed=np.array(gripper_closed),
         corruption=np.zeros(3),
     )
+
+
+def test_a_bridge_that_turns_further_takes_more_steps(clean_env):
+    env = clean_env
+    obs = env.reset(0)
+    start = env.eef_pose()
+    turned = make_pose(start[:3, 3], rot_z(np.pi / 2) @ start[:3, :3])
+    segment = _held_goal_segment(env, turned, [False])
     cfg = ReplayConfig(interpolation_steps=5, interpolation_rotation_speed=0.1, hold_steps=0)
     outcome = replay_segment(env, EpisodeRecorder(env), obs, segment, cfg, np.random.default_rng(0), False, 100)
     assert len(outcome.interpolation) == int(np.ceil((np.pi / 2) / 0.1))  # 16: the angle, not the (zero) distance
@@ -131,17 +137,7 @@ def test_the_bridge_holds_the_command_the_segment_settles_on(clean_env, recorded
     obs = env.reset(0)
     start = env.eef_pose()
     away = make_pose(start[:3, 3] + [0.1, 0.0, 0.0], start[:3, :3])
-    segment = SourceSegment(
-        episode=0,
-        subtask=0,
-        role=SegmentRole.SUBTASK,
-        object_name="block",
-        T_world_obj=env.true_object_poses()["block"],
-        eef=np.repeat(away[None], len(recorded), axis=0),
-        targets=np.repeat(away[None], len(recorded), axis=0),
-        gripper_closed=np.array(recorded),
-        corruption=np.zeros(3),
-    )
+    segment = _held_goal_segment(env, away, recorded)
     cfg = ReplayConfig(interpolation_steps=5, interpolation_speed=0.015, hold_steps=0, bridge_gripper_frames=frames)
     recorder = EpisodeRecorder(env)
     outcome = replay_segment(env, recorder, obs, segment, cfg, np.random.default_rng(0), False, 100)
