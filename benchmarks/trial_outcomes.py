@@ -15,6 +15,11 @@ policy seeded per trial, as ``igen-eval`` does), its frames recorded, and its en
 Beside the counts, each outcome's median final offset of the held part from the target's axis
 (table plane, true poses) and of its bottom above the seat, in mm: where the failures ended.
 
+For each release before contact, the step at which the run of open commands that let the part go
+began, and (a recurrent policy with a ``horizon``) how many of them began at a hidden-state reset
+(step divisible by the horizon): a one-step open sampled at a reset widens the fingers, and a policy
+that reads wider fingers as the release phase goes on opening.
+
 A rerun trial must end as the report says: a mismatch is printed and counted, so a table's reading
 never rests on trials that did not replay.
 
@@ -61,6 +66,14 @@ def classify(success: bool, width: np.ndarray, contact: np.ndarray, holding_widt
     return OUTCOMES[3] if first_release is not None else OUTCOMES[4]
 
 
+def release_onset(closed: np.ndarray, width: np.ndarray, holding_width: float) -> int:
+    """The step at which the run of open commands that first let the part go began."""
+    step = int(np.flatnonzero(width > holding_width)[0])
+    while step > 0 and not closed[step - 1]:
+        step -= 1
+    return step
+
+
 def final_offsets(env, geometry) -> tuple[float, float]:
     """The held part's distance from the target's axis in the table plane, and its bottom above the seat [m]."""
     poses = env.true_object_poses()
@@ -84,7 +97,9 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
     contact_col = names.index("contact")
     env = config.make_task_env()
     policy = make_base_policy(PolicySourceConfig(path=result["policy"]), config)
-    counts, mismatches = Counter(), []
+    recurrent = getattr(getattr(policy, "policy", None), "config", None)  # a checkpoint's LeRobot policy config
+    horizon = getattr(recurrent, "horizon", None)  # BC-RNN's hidden-state reset period
+    counts, mismatches, onsets = Counter(), [], []
     ends: dict[str, list[tuple[float, float]]] = {name: [] for name in OUTCOMES}
     trials = report["n_trials"] if max_trials is None else min(max_trials, report["n_trials"])
     try:
@@ -97,6 +112,9 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
             width = episode.state[:, spec.state_names.index("gripper.width")]
             outcome = classify(success, width, episode.env_state[:, contact_col] > 0.5, geometry.holding_width)
             counts[outcome] += 1
+            if outcome == OUTCOMES[1]:
+                closed = np.array([env.gripper_command(action) for action in episode.action])
+                onsets.append(release_onset(closed, width, geometry.holding_width))
             ends[outcome].append(final_offsets(env, geometry))
     finally:
         env.close()
@@ -107,6 +125,8 @@ def trial_outcomes(report_path: Path, max_trials: int | None) -> dict:
         "outcomes": {name: counts[name] for name in OUTCOMES},
         "median_final_off_axis_mm": {n: _median_mm(e, 0) for n, e in ends.items() if e},
         "median_final_above_seat_mm": {n: _median_mm(e, 1) for n, e in ends.items() if e},
+        "release_before_contact_onsets": onsets,
+        **({"onsets_at_a_hidden_state_reset": sum(s % horizon == 0 for s in onsets)} if horizon else {}),
         "trials_not_replayed": mismatches,
     }
 
