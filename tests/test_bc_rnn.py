@@ -339,3 +339,41 @@ def test_another_datasets_statistics_normalise_the_inputs_and_the_actions_keep_t
     (base / "meta" / "stats.json").write_text(json.dumps(elsewhere))
     with pytest.raises(ConfigError, match=r"has no mean/std for \['observation.environment_state'\]"):
         processors(base)
+
+
+def test_an_input_constant_in_the_data_is_found_by_its_range_when_lerobots_std_is_not_zero():
+    """2-Piece Assembly's receptacle height: 0.82 in every frame, yet LeRobot's episode stats give it a std."""
+    from lerobot.configs import FeatureType, PolicyFeature
+    from lerobot.datasets.compute_stats import aggregate_stats, compute_episode_stats
+
+    from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
+    from igen_lerobot.training.bc_rnn.processor_bc_rnn import make_bc_rnn_pre_post_processors
+
+    rng = np.random.default_rng(0)
+    episodes = []
+    for _ in range(3):  # a varying input beside the receptacle's fixed height, as a generated dataset writes them
+        column = np.stack([rng.normal(0.0, 0.03, 50), np.full(50, 0.82)], axis=1).astype(np.float32)
+        features = {"observation.environment_state": {"dtype": "float32", "shape": (2,)}}
+        episodes.append(compute_episode_stats({"observation.environment_state": column}, features))
+    env_stats = aggregate_stats(episodes)["observation.environment_state"]
+    assert env_stats["max"][1] == env_stats["min"][1]
+    assert env_stats["std"][1] > 1e-6, "LeRobot's float32 E[x^2] - E[x]^2 no longer leaves a std here: revisit"
+
+    config = BCRNNConfig(
+        input_features={"observation.environment_state": PolicyFeature(FeatureType.ENV, (2,))},
+        output_features={"action": PolicyFeature(FeatureType.ACTION, (1,))},
+    )
+    stats = {
+        "observation.environment_state": env_stats,
+        "action": {"min": np.array([-1.0]), "max": np.array([1.0])},
+    }
+    pre, _ = make_bc_rnn_pre_post_processors(config, stats)
+    error = 0.01  # a 1 cm error on the observed height, as the paper's error model draws
+    out = pre({"observation.environment_state": torch.tensor([[0.0, 0.82 + error]])})
+    # in its own units, as robomimic's unnormalised inputs (the std 3e-4 would make it ~30 std)
+    assert float(out["observation.environment_state"][0, 1]) == pytest.approx(error, rel=1e-3)
+    # the varying input keeps its own std: 0.03 reads as about one std
+    varying = pre({"observation.environment_state": torch.tensor([[0.03, 0.82]])})
+    assert float(varying["observation.environment_state"][0, 0]) == pytest.approx(
+        (0.03 - env_stats["mean"][0]) / env_stats["std"][0], rel=1e-3
+    )

@@ -45,7 +45,7 @@ class BCRNNConfig(PreTrainedConfig):
     # normalises). Without it, an input that never varies in the data (a fixed peg's height) gets
     # std ~0 and any deviation at test time is multiplied by ~1e8.
     obs_std_tolerance: float = 0.0
-    # [input units] the std given to an input that never varies in the data (std < 1e-6); 0 keeps its
+    # [input units] the std given to an input that never varies in the data (std or range < 1e-6); 0 keeps its
     # ~0 std. 1.0 passes its deviations through in their own units (a flag's 0 -> 1, a height error
     # in metres), as robomimic's unnormalised inputs do; inputs that vary keep mean/std. With LeRobot's
     # ~0 std, a 0.5 mm error on a fixed peg's height made the Nut Insertion base policy drop the nut

@@ -15,7 +15,24 @@ from igen_lerobot.training.bc_rnn.configuration_bc_rnn import BCRNNConfig
 
 logger = logging.getLogger(__name__)
 
-CONSTANT_STD = 1e-6  # [input units] below this an input counts as constant in the data
+CONSTANT_STD = 1e-6  # [input units] a std or a range below this: the input is constant in the data
+
+
+def constant_inputs(stats: dict[str, torch.Tensor]) -> torch.Tensor:
+    """Which entries of one feature never vary in the data: a tiny std, or a tiny range where min/max are known.
+
+    The range is the test that holds: LeRobot's per-episode std is sqrt(E[x^2] - E[x]^2) in float32
+    (``RunningQuantileStats``), which cancels badly for a constant away from zero. 2-Piece Assembly's
+    receptacle height, 0.82 in every frame (min = max), got a std of 3.3e-4, so a 1 cm observation
+    error on it reached the network as 30 standard deviations; Nut Insertion's peg height, 0.865 in
+    every frame, got 5.7e-8.
+    """
+    std = torch.as_tensor(stats["std"])
+    constant = std < CONSTANT_STD
+    if "min" in stats and "max" in stats:
+        spread = torch.as_tensor(stats["max"]) - torch.as_tensor(stats["min"])
+        constant = constant | (spread.reshape(std.shape) < CONSTANT_STD)
+    return constant
 
 
 def make_bc_rnn_pre_post_processors(
@@ -56,7 +73,7 @@ def input_stats(
     for key in normalised & set(stats):
         std = torch.as_tensor(stats[key]["std"])
         if config.constant_input_std > 0:  # constant inputs: only centred, their deviations kept in input units
-            std = torch.where(std < CONSTANT_STD, torch.full_like(std, config.constant_input_std), std)
+            std = torch.where(constant_inputs(stats[key]), torch.full_like(std, config.constant_input_std), std)
         out[key] = {**stats[key], "std": std + config.obs_std_tolerance}
     return out
 
@@ -88,13 +105,12 @@ def warn_constant_inputs(stats: dict[str, dict[str, torch.Tensor]], keys: set[st
     """
     found = []
     for key in sorted(keys & set(stats)):
-        std = torch.as_tensor(stats[key]["std"]).flatten()
-        constant = [i for i, s in enumerate(std.tolist()) if s < CONSTANT_STD]
+        constant = [i for i, c in enumerate(constant_inputs(stats[key]).flatten().tolist()) if c]
         if constant:
             found.append(f"{key}{constant}")
     if found:
         logger.warning(
-            "inputs that never vary in the training data (std < %g): %s. Mean/std normalisation divides any "
+            "inputs that never vary in the training data (std or range < %g): %s. Mean/std normalisation divides any "
             "deviation from them at run time by that std (LeRobot adds only 1e-8); --policy.obs_std_tolerance=1e-3 "
             "(robomimic's value) bounds it",
             CONSTANT_STD,
