@@ -13,45 +13,28 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-import pyarrow.parquet as pq
+from lerobot.utils.import_utils import register_third_party_plugins
 
-COLUMNS = (
-    "action",
-    "frame_index",
-    "episode_index",
-    "complementary_info.is_intervention",
-    "complementary_info.corruption",
-)
-
-
-def _columns(root: Path) -> dict[str, np.ndarray]:
-    tables = [pq.read_table(path, columns=list(COLUMNS)) for path in sorted((root / "data").rglob("*.parquet"))]
-    out = {}
-    for name in COLUMNS:
-        parts = [np.stack(t.column(name).to_numpy(zero_copy_only=False)) for t in tables]
-        out[name] = np.concatenate(parts)
-    return out
+from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 
 
 def policy_opens(root: Path) -> list[dict]:
-    """Per episode: policy frames before the first flagged one, their open commands, the pose error."""
-    cols = _columns(root)
-    gripper = cols["action"][:, -1]
-    flagged = cols["complementary_info.is_intervention"].reshape(len(gripper), -1)[:, 0] > 0
+    """Per episode: policy frames before the first flagged one, their open commands, the pose error.
+
+    Open is what the task's action space does not read as closed (gripper command <= 0).
+    """
     rows = []
-    for episode in np.unique(cols["episode_index"]):
-        rows_of = np.flatnonzero(cols["episode_index"] == episode)
-        rows_of = rows_of[np.argsort(cols["frame_index"][rows_of])]
-        takeover = int(np.argmax(flagged[rows_of])) if flagged[rows_of].any() else len(rows_of)
-        policy = rows_of[:takeover]
+    for index, episode in enumerate(load_episodes(root, dataset_spec(root))):
+        flagged = episode.is_intervention
+        takeover = int(flagged.argmax()) if flagged.any() else episode.length
+        gripper = episode.action[:, -1]
         rows.append(
             {
-                "episode": int(episode),
+                "episode": index,
                 "policy_frames": takeover,
-                "first_three": gripper[rows_of[:3]].round(2).tolist(),
-                "open_frames": cols["frame_index"][policy][gripper[policy] < 0].astype(int).tolist(),
-                "pose_error_m": cols["complementary_info.corruption"][rows_of[0]].round(4).tolist(),
+                "first_three": gripper[:3].round(2).tolist(),
+                "open_frames": [int(t) for t in range(takeover) if gripper[t] <= 0],
+                "pose_error_m": episode.corruption.round(4).tolist(),
             }
         )
     return rows
@@ -61,12 +44,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("roots", nargs="+", type=Path, help="source intervention datasets (LeRobot folders)")
     args = parser.parse_args()
+    register_third_party_plugins()  # the tasks, to read each dataset under its own spec
     for root in args.roots:
         rows = policy_opens(root)
         for row in rows:
             print(row)
         with_open = sum(bool(row["open_frames"]) for row in rows)
-        starting_open = sum(row["first_three"][0] < 0 for row in rows)
+        starting_open = sum(row["first_three"][0] <= 0 for row in rows)
         print(
             f"{root}: {with_open}/{len(rows)} policy segments command open before the takeover, "
             f"{starting_open} at their first frame"
