@@ -3,6 +3,7 @@ started on a loopback address for these tests."""
 
 from __future__ import annotations
 
+import logging
 import socket
 import threading
 import time
@@ -459,6 +460,38 @@ def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(e
             jerk_factor=0.2,
         )
         arm.move_home()
+        np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)  # tolerance 5 mm
+    finally:
+        arm.disconnect()
+
+
+def test_a_move_home_that_returns_without_moving_is_caught_and_tried_again(empty_sim, caplog):
+    """franky can return from a motion the arm refused without an error; the arm then stays where the
+    trial left it. The move home checks where the hand ended and tries again: a trial never starts
+    away from home. The refusal is injected (the first move returns at once); franky-sim does the rest."""
+    arm = connected(empty_sim)
+    try:
+        arm.move_home()
+        home = arm.read_state().T_base_eef[:3, 3].copy()
+        T = arm.read_state().T_base_eef.copy()
+        T[:3, 3] += (0.0, 0.10, -0.05)
+        arm.send_target(T)
+        time.sleep(2.0)
+        assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.08
+
+        moves = []
+        real_move = arm._move_and_wait
+
+        def refused_once(what, motion):
+            moves.append(what)
+            if len(moves) > 1:
+                real_move(what, motion)
+
+        arm._move_and_wait = refused_once
+        with caplog.at_level(logging.WARNING):
+            arm.move_home()
+        assert len(moves) == 2
+        assert "cm from home" in caplog.text and "trying the move home once more" in caplog.text
         np.testing.assert_allclose(arm.read_state().T_base_eef[:3, 3], home, atol=0.005)  # tolerance 5 mm
     finally:
         arm.disconnect()

@@ -138,6 +138,28 @@ def test_rehearsal_runs_franky_on_franky_sim_started_by_itself(bc_rnn_checkpoint
     assert (table / "rehearsal" / "step_times.json").read_text() == times
 
 
+def test_a_stopped_deploy_runs_report_is_kept_aside_and_a_rerun_redoes_it(tmp_path):
+    """igen-deploy writes the trials of a run it stopped, then fails: the evidence stays, the step is redone."""
+    from igen_lerobot.experiments.ledger import Ledger
+    from igen_lerobot.experiments.rehearsal import run_step
+    from igen_lerobot.experiments.step_runner import StepFailedError, StepRunner
+
+    out, ledger = tmp_path / "out", tmp_path / "ledger"
+    runner = StepRunner(out, ledger=Ledger(ledger, out))
+    report = out / "rehearsal" / "reports" / "igen" / "seed8" / "franky.json"
+    report.parent.mkdir(parents=True)
+    stopped_run = ["sh", "-c", f'echo \'{{"stopped": {{"before_trial": 17}}}}\' > {report}; exit 1']
+    with pytest.raises(StepFailedError, match="franky.stopped.json"):
+        run_step(runner, "rehearse_franky_igen_seed8", stopped_run, report)
+    kept = report.with_name("franky.stopped.json")
+    assert not report.exists()  # a rerun must not take the stopped run for a finished one
+    assert json.loads(kept.read_text()) == {"stopped": {"before_trial": 17}}
+    assert (ledger / kept.relative_to(out)).read_text() == kept.read_text()  # kept across machines too
+
+    run_step(runner, "rehearse_franky_igen_seed8", ["sh", "-c", f"echo '{{\"stopped\": null}}' > {report}"], report)
+    assert json.loads(report.read_text()) == {"stopped": None} and kept.exists()
+
+
 def test_a_resumed_rehearsal_refuses_settings_that_change_finished_steps(tmp_path):
     from igen_lerobot.experiments.rehearsal import check_resumed
 

@@ -127,14 +127,28 @@ def path_command(
 
 
 def run_step(runner: StepRunner, name: str, command: list[str], report: Path) -> None:
-    """One (row, path): skipped when its report exists; a failed run leaves no report, so a rerun redoes it."""
+    """One (row, path): skipped when its report exists.
+
+    igen-deploy writes the trials of a run it stopped (the arm could not go home), then fails: that
+    report is moved aside to ``<path>.stopped.json``, so a rerun redoes the run and the evidence of the
+    stop (each trial's outcome and fault) is kept.
+    """
     if not (report.exists() or runner.in_process or shutil.which(command[0])):
         raise ConfigError(f"{Path(command[0]).name} is not installed here; run `make setup` (scripts/setup.sh)")
     try:
         runner.run(name, command, report)
-    except StepFailedError:
-        report.unlink(missing_ok=True)  # igen-deploy writes the trials of a run it stopped, then fails
+    except StepFailedError as error:
+        if report.exists():
+            kept = stopped_report_path(report)
+            report.replace(kept)
+            runner.ledger.keep(kept)
+            raise StepFailedError(f"{error}\nits report of the trials run is kept in {kept}") from error
         raise
+
+
+def stopped_report_path(report: Path) -> Path:
+    """Where the report of a run igen-deploy stopped is kept: beside the report a rerun writes."""
+    return report.with_suffix(".stopped.json")
 
 
 def seed_result(path: str, report: dict) -> dict:

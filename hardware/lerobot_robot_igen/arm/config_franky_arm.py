@@ -63,6 +63,9 @@ class FrankyArmConfig(ArmBackendConfig):
     # [s] the longest the move home may take before the arm is stopped and an error raised (a blocking
     # move waits for a motion the arm may never finish: the process would hang with the arm in its hands)
     home_timeout: float = 30.0
+    # [m] how far from home a finished move home may leave the hand: a motion refused without an error
+    # (surfacing only at the next command) returns at once and leaves the arm where the trial ended
+    home_tolerance: float = 0.02
     # [s] the longest connect() waits for the arm and gripper to answer: libfranka waits without end on an
     # address that accepts the connection and never answers (measured against a silent socket)
     connect_timeout: float = 10.0
@@ -80,6 +83,7 @@ class FrankyArmConfig(ArmBackendConfig):
             "max_lead",
             "stream_period",
             "home_timeout",
+            "home_tolerance",
             "connect_timeout",
         ):
             if not getattr(self, name) > 0:

@@ -59,6 +59,7 @@ class FrankyArm(ArmDriver):
         self._gripper_worker: GripperWorker | None = None
         self._tracker: ImpedanceTracker | None = None
         self._home_joints: np.ndarray | None = None  # where the first Cartesian move home ended
+        self._home_reached: np.ndarray | None = None  # the hand's position there [m] (base frame)
         self._T_tcp_site = np.eye(4)
         self._T_tcp_site[:3, :3] = np.asarray(config.tcp_to_site_rotation, dtype=float)
         self._T_site_tcp = np.linalg.inv(self._T_tcp_site)
@@ -275,7 +276,7 @@ class FrankyArm(ArmDriver):
         factor = self._franky.RelativeDynamicsFactor(cfg.home_velocity_factor, cfg.acceleration_factor, cfg.jerk_factor)
         self._finish_last_motion()
         try:
-            self._move_and_wait("the move home", self._motion(T_home, factor))
+            self._move_home_to(T_home[:3, 3], "the move home", self._motion(T_home, factor))
         except (ConnectionLostError, MotionTimeoutError):
             raise
         except DriverError as error:
@@ -284,7 +285,7 @@ class FrankyArm(ArmDriver):
             logger.warning("%s; recovering and trying the move home once more", error)
             self._finish_last_motion()
             try:
-                self._move_and_wait("the move home", self._motion(T_home, factor))
+                self._move_home_to(T_home[:3, 3], "the move home", self._motion(T_home, factor))
             except DriverError as again:
                 if self._home_joints is None or isinstance(again, (ConnectionLostError, MotionTimeoutError)):
                     raise
@@ -295,13 +296,30 @@ class FrankyArm(ArmDriver):
                 joints = self._franky.JointMotion(
                     self._franky.JointState(self._home_joints), relative_dynamics_factor=factor
                 )
-                self._move_and_wait("the move home (joint space)", joints)
+                self._move_home_to(self._home_reached, "the move home (joint space)", joints)
         if self._home_joints is None:
             self._home_joints = self._call(
                 "a state read", lambda: np.asarray(self.robot.current_joint_positions, float)
             )
+            self._home_reached = self.read_state().eef_position.copy()
         self.set_gripper(False)
         self.wait_gripper(2 * self.config.gripper_timeout)  # a grasp still settling, then the opening
+
+    def _move_home_to(self, home: np.ndarray, what: str, motion) -> None:
+        """A blocking move home, checked where it ended: a trial must never start away from home.
+
+        franky can return from a motion the arm refused without an error (the error surfaces at the
+        next command); the arm then stays where the last trial left it. Seen in a rehearsal: a trial
+        began with the hand 50 cm from home, outside the workspace, and the safety layer stopped it.
+        """
+        self._move_and_wait(what, motion)
+        reached = self.read_state().eef_position
+        off = float(np.linalg.norm(reached - home))
+        if off > self.config.home_tolerance:
+            raise DriverError(
+                f"{what} ended {100 * off:.1f} cm from home, with the hand at {np.round(reached, 3).tolist()} m "
+                f"(base frame; --robot.home_tolerance={self.config.home_tolerance:g} m)"
+            )
 
     def _move_and_wait(self, what: str, motion) -> None:
         """A blocking move with a deadline.
