@@ -50,6 +50,18 @@ def connected(host, controller: str = "trajectory"):
     return arm
 
 
+def moved_away_from_home(arm: FrankyArm, offset: tuple[float, float, float]) -> np.ndarray:
+    """Take the arm home, then ``offset`` [m] away from it (asserted); returns where home was."""
+    arm.move_home()
+    home = arm.read_state().T_base_eef[:3, 3].copy()
+    T = arm.read_state().T_base_eef.copy()
+    T[:3, 3] += offset
+    arm.send_target(T)
+    time.sleep(2.0)
+    assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.8 * np.linalg.norm(offset)
+    return home
+
+
 def test_state_frames_and_home(empty_sim):
     arm = connected(empty_sim)
     try:
@@ -442,13 +454,7 @@ def test_the_move_home_falls_back_to_joint_space_when_the_cartesian_plan_fails(e
 
     arm = connected(empty_sim)
     try:
-        arm.move_home()
-        home = arm.read_state().T_base_eef[:3, 3].copy()
-        T = arm.read_state().T_base_eef.copy()
-        T[:3, 3] += (0.05, 0.08, -0.05)
-        arm.send_target(T)
-        time.sleep(2.0)
-        assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.05
+        home = moved_away_from_home(arm, (0.05, 0.08, -0.05))
         # no Cartesian plan exists. The deadline and the pace are the fallback's, not what this test is
         # about: the joint-space move home at 5% acceleration and jerk ran past the 30 s default in CI,
         # when franky-sim's clock had fallen to about half of wall time; at 20% it takes a few seconds
@@ -471,14 +477,7 @@ def test_a_move_home_that_returns_without_moving_is_caught_and_tried_again(empty
     away from home. The refusal is injected (the first move returns at once); franky-sim does the rest."""
     arm = connected(empty_sim)
     try:
-        arm.move_home()
-        home = arm.read_state().T_base_eef[:3, 3].copy()
-        T = arm.read_state().T_base_eef.copy()
-        T[:3, 3] += (0.0, 0.10, -0.05)
-        arm.send_target(T)
-        time.sleep(2.0)
-        assert np.linalg.norm(arm.read_state().T_base_eef[:3, 3] - home) > 0.08
-
+        home = moved_away_from_home(arm, (0.0, 0.10, -0.05))
         moves = []
         real_move = arm._move_and_wait
 
