@@ -562,6 +562,38 @@ def test_a_step_stopped_by_sigterm_records_its_leg_and_resumes(tmp_path):
     assert "plus 0.0 min in the legs of 1 step stopped between sessions" in "\n".join(provenance_lines(result))
 
 
+def test_a_step_that_dies_of_a_crash_signal_runs_once_more_and_its_legs_count(tmp_path):
+    """Native code can crash where a rerun succeeds (a segmentation fault in lerobot-train): the step runs
+    once more, with what it would run when resumed (worked out again), and both legs count in its time.
+    A second crash, or an ordinary failure, fails the step: nothing loops."""
+    from igen_lerobot.experiments.step_runner import StepFailedError, StepRunner
+
+    runner = StepRunner(tmp_path)
+    legs = tmp_path / "legs"
+    # the first leg sleeps 1 s and dies of SIGSEGV; the second finishes
+    flaky = f"echo leg >> {legs}; if [ $(wc -l < {legs}) -eq 1 ]; then sleep 1; kill -SEGV $$; fi; touch done"
+    worked_out = []
+
+    def resumed() -> list[str]:
+        worked_out.append(len(worked_out))
+        return ["sh", "-c", f"cd {tmp_path} && {flaky}"]
+
+    runner.run("train_x", ["lerobot-train", "--steps=5"], tmp_path / "done", resumed)
+    assert legs.read_text().count("leg") == 2 and worked_out == [0, 1]
+    assert runner.timings["train_x"] >= 1.0  # tolerance: the crashed leg's sleep is counted
+    assert "train_x: died of SIGSEGV; running it once more" in (tmp_path / "logs" / "train_x.log").read_text()
+    assert runner.commands[-1]["command"] == "lerobot-train --steps=5"  # the recorded command is unchanged
+
+    always = tmp_path / "always"
+    with pytest.raises(StepFailedError, match=r"exit -6"):
+        runner.run("eval_y", ["sh", "-c", f"echo leg >> {always}; kill -ABRT $$"], tmp_path / "never")
+    assert always.read_text().count("leg") == 2
+    once = tmp_path / "once"
+    with pytest.raises(StepFailedError, match=r"exit 3"):
+        runner.run("eval_z", ["sh", "-c", f"echo leg >> {once}; exit 3"], tmp_path / "never")
+    assert once.read_text().count("leg") == 1
+
+
 def test_each_step_records_the_code_checked_out_when_it_started(tmp_path, monkeypatch):
     """A commit landed while a table runs is named by the steps started after it, not the earlier ones."""
     from igen_lerobot.experiments import step_runner

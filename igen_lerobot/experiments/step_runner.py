@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from importlib.metadata import entry_points
 from pathlib import Path
 
@@ -31,6 +32,20 @@ logger = logging.getLogger(__name__)
 
 class StepFailedError(IgenError, RuntimeError):
     """A command of the table failed; the message names it and the end of its log."""
+
+
+CRASH_RETRIES = 1  # runs more of a step that died of a crash signal
+# signals of native crashes: seen in lerobot-train on this project's 2-core VM (a segmentation fault in
+# libtorch_cpu, a general protection fault in libc10, glibc's heap check aborting), each gone when the
+# same command ran again. Not SIGKILL or SIGTERM: someone (or the OOM killer) meant those
+CRASH_SIGNALS = (signal.SIGSEGV, signal.SIGBUS, signal.SIGABRT, signal.SIGILL, signal.SIGFPE)
+
+
+def crash_signal(returncode: int) -> str | None:
+    """The name of the crash signal a process died of, from its return code; None for any other end."""
+    if returncode < 0 and -returncode in {int(s) for s in CRASH_SIGNALS}:
+        return signal.Signals(-returncode).name
+    return None
 
 
 class StepRunner:
@@ -84,14 +99,17 @@ class StepRunner:
         name: str,
         command: list[str],
         done: Path,
-        execute: list[str] | None = None,
+        execute: list[str] | Callable[[], list[str]] | None = None,
         env: dict[str, str] | None = None,
         reads: Path | None = None,
     ) -> None:
         """Run ``command`` unless ``done`` exists; its output is appended to ``logs/<name>.log``.
 
-        ``execute``, when given, is what actually runs (a training resumed from its checkpoint),
-        while ``command`` is what the table records: the command that makes the step from scratch.
+        ``execute``, when given, is what actually runs (a training resumed from its checkpoint), or a
+        function that says so when it runs, while ``command`` is what the table records: the command
+        that makes the step from scratch. A step that dies of a crash signal (segmentation fault,
+        abort: native code, not the step's own error) is run once more, as a rerun of the table would
+        run it; both legs count in its time.
         ``env``: variables the command runs with, recorded in front of it as a shell would take them.
         ``reads``: the dataset a training step reads, whose digest is recorded when the step finishes.
         """
@@ -105,27 +123,35 @@ class StepRunner:
             return
         log = self.out / "logs" / f"{name}.log"
         log.parent.mkdir(parents=True, exist_ok=True)
-        command = execute or command
         self.executed.append(name)
-        logger.info("%s: %s", name, shlex.join([Path(command[0]).name, *command[1:]]))
         # the code checked out when this step starts, which is what its subprocess imports: a commit
         # landed while a long table runs shows in the steps started after it, not in the earlier ones
         step_code = code_version()
         start, cpu_start = time.perf_counter(), cpu_seconds()
-        try:
-            with _termination_as_interrupt():
-                if self.in_process:
-                    code = _run_in_process(command, log, env)
-                else:
-                    with open(log, "a") as sink:
-                        code = subprocess.run(
-                            command, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
-                        ).returncode
-        except KeyboardInterrupt:
-            self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
-            self.write_step_records()
-            logger.info("%s: stopped; rerun to resume it", name)
-            raise
+        for leg in range(1 + CRASH_RETRIES):
+            ran = (execute() if callable(execute) else execute) or command
+            logger.info("%s: %s", name, shlex.join([Path(ran[0]).name, *ran[1:]]))
+            try:
+                with _termination_as_interrupt():
+                    if self.in_process:
+                        code = _run_in_process(ran, log, env)
+                    else:
+                        with open(log, "a") as sink:
+                            code = subprocess.run(
+                                ran, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
+                            ).returncode
+            except KeyboardInterrupt:
+                self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
+                self.write_step_records()
+                logger.info("%s: stopped; rerun to resume it", name)
+                raise
+            crash = crash_signal(code)
+            if crash is None or leg == CRASH_RETRIES:
+                break
+            message = f"{name}: died of {crash}; running it once more (a training resumes from its last checkpoint)"
+            logger.warning(message)
+            with open(log, "a") as sink:
+                sink.write(f"\n{message}\n")
         if code == 0 and done.exists():
             # a resumed step adds this leg to what earlier legs recorded
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - start

@@ -24,6 +24,7 @@ import logging
 import re
 import time
 from dataclasses import MISSING, asdict, fields, is_dataclass, replace
+from functools import partial
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import ConfigError
@@ -254,7 +255,9 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     final = final_checkpoint(out, cfg.steps)
     done = final / "config.json"
     command = train_command(cfg, dataset, f"local/{dataset.name}", out)
-    execute = None if done.exists() else run_command(cfg, dataset, f"local/{dataset.name}", out)
+    # worked out as it runs, and again if it is run once more after a crash: it resumes from the
+    # checkpoint the crashed leg saved last
+    execute = None if done.exists() else partial(run_command, cfg, dataset, f"local/{dataset.name}", out)
     may_skip = not (weights_needed or run.cfg.retrain_restored or run.dry_run or done.exists())
     if may_skip and run_on_record(run.cfg, run.out, run.columns, variant, seed):
         done = validation_report(run.out, variant, seed)  # its numbers stand: no checkpoint is read again
