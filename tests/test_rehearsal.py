@@ -156,6 +156,10 @@ def test_a_stopped_deploy_runs_report_is_kept_aside_and_a_rerun_redoes_it(tmp_pa
     assert json.loads(kept.read_text()) == {"stopped": {"before_trial": 17}}
     assert (ledger / kept.relative_to(out)).read_text() == kept.read_text()  # kept across machines too
 
+    with pytest.raises(StepFailedError, match="franky.stopped2.json"):  # a second stop keeps the first's report
+        run_step(runner, "rehearse_franky_igen_seed8", stopped_run, report)
+    assert json.loads(kept.read_text()) == {"stopped": {"before_trial": 17}}
+
     run_step(runner, "rehearse_franky_igen_seed8", ["sh", "-c", f"echo '{{\"stopped\": null}}' > {report}"], report)
     assert json.loads(report.read_text()) == {"stopped": None} and kept.exists()
 

@@ -130,8 +130,8 @@ def run_step(runner: StepRunner, name: str, command: list[str], report: Path) ->
     """One (row, path): skipped when its report exists.
 
     igen-deploy writes the trials of a run it stopped (the arm could not go home), then fails: that
-    report is moved aside to ``<path>.stopped.json``, so a rerun redoes the run and the evidence of the
-    stop (each trial's outcome and fault) is kept.
+    report is moved aside (:func:`stopped_report_path`), so a rerun redoes the run and the evidence of
+    each stop (every trial's outcome and fault) is kept.
     """
     if not (report.exists() or runner.in_process or shutil.which(command[0])):
         raise ConfigError(f"{Path(command[0]).name} is not installed here; run `make setup` (scripts/setup.sh)")
@@ -147,8 +147,15 @@ def run_step(runner: StepRunner, name: str, command: list[str], report: Path) ->
 
 
 def stopped_report_path(report: Path) -> Path:
-    """Where the report of a run igen-deploy stopped is kept: beside the report a rerun writes."""
-    return report.with_suffix(".stopped.json")
+    """Where the report of a run igen-deploy stopped is kept: beside the one a rerun writes.
+
+    Never over an earlier stopped run's: ``<path>.stopped.json``, then ``.stopped2.json``, ...
+    """
+    kept, n = report.with_suffix(".stopped.json"), 1
+    while kept.exists():
+        n += 1
+        kept = report.with_suffix(f".stopped{n}.json")
+    return kept
 
 
 def seed_result(path: str, report: dict) -> dict:

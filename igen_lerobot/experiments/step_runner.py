@@ -34,7 +34,7 @@ class StepFailedError(IgenError, RuntimeError):
     """A command of the table failed; the message names it and the end of its log."""
 
 
-CRASH_RETRIES = 1  # runs more of a step that died of a crash signal
+CRASH_RETRIES = 1  # how many more times a step that died of a crash signal is run
 # signals of native crashes: seen in lerobot-train on this project's 2-core VM (a segmentation fault in
 # libtorch_cpu, a general protection fault in libc10, glibc's heap check aborting), each gone when the
 # same command ran again. Not SIGKILL or SIGTERM: someone (or the OOM killer) meant those
@@ -43,7 +43,7 @@ CRASH_SIGNALS = (signal.SIGSEGV, signal.SIGBUS, signal.SIGABRT, signal.SIGILL, s
 
 def crash_signal(returncode: int) -> str | None:
     """The name of the crash signal a process died of, from its return code; None for any other end."""
-    if returncode < 0 and -returncode in {int(s) for s in CRASH_SIGNALS}:
+    if -returncode in CRASH_SIGNALS:  # a process killed by signal N returns -N
         return signal.Signals(-returncode).name
     return None
 
