@@ -51,10 +51,13 @@ class FrankyArmConfig(ArmBackendConfig):
     jerk_factor: float = 0.05
     home_position: tuple[float, float, float] = (0.51, 0.0, 0.2)  # [m] base frame, hand top-down
     home_velocity_factor: float = 0.2  # the (blocking) move home; acceleration and jerk as above
-    # [m] 1 cm under the 5 cm cube: a real hand applies grasp_force once its fingers stop on the cube,
-    # whatever the width; franky-sim drives its fingers towards the width, and squeezes only below the cube
-    grasp_width: float = 0.04
-    grasp_tolerance: float = 0.03  # [m] epsilon in/out: a grasp stopping at 1-7 cm (anything cube-sized) succeeds
+    # [m] the fingers close as far as they go, as the training gripper's do: on the cube they stop at its
+    # 5 cm and squeeze with grasp_force; on air they close to ~0, which is how a policy trained in MuJoCo
+    # reads a missed grasp (at 4 cm, the old width, they stopped half-closed: a width it never saw)
+    grasp_width: float = 0.0
+    # [m] epsilon in/out: every width the hand reaches counts as a grasp, so the hand never reports a
+    # grasp failed (and lets go) because the fingers stopped where nothing was expected
+    grasp_tolerance: float = 0.08
     grasp_force: float = 20.0  # [N]
     gripper_speed: float = 0.1  # [m/s]
     open_width: float = 0.08  # [m]
@@ -88,6 +91,11 @@ class FrankyArmConfig(ArmBackendConfig):
         ):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"--robot.{name} must be > 0, got {getattr(self, name)}")
+        if not 0 <= self.grasp_width < self.open_width:
+            raise ConfigError(
+                f"--robot.grasp_width must be in [0, open_width={self.open_width}) m, got {self.grasp_width} "
+                "(0, the default, closes the fingers as far as they go, as the training gripper does)"
+            )
 
     def make_driver(self, env_config=None) -> ArmDriver:
         from lerobot_robot_igen.arm.franky_arm import FrankyArm
