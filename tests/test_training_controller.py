@@ -82,7 +82,10 @@ def test_a_stall_is_not_integrated_as_a_leap():
     assert 0.0 < once[0] < 0.03
 
 
-@pytest.mark.parametrize("field, value", [("controller", "ruckig"), ("tracker_stiffness", 0.0), ("max_lead", -1.0)])
+@pytest.mark.parametrize(
+    "field, value",
+    [("controller", "ruckig"), ("tracker_stiffness", 0.0), ("max_lead", -1.0), ("grasp_width", -0.01), ("grasp_width", 0.08)],
+)
 def test_bad_controller_settings_name_the_flag(field, value):
     from igen_lerobot.core.exceptions import ConfigError
 
