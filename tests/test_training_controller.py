@@ -84,7 +84,14 @@ def test_a_stall_is_not_integrated_as_a_leap():
 
 @pytest.mark.parametrize(
     "field, value",
-    [("controller", "ruckig"), ("tracker_stiffness", 0.0), ("max_lead", -1.0), ("grasp_width", -0.01), ("grasp_width", 0.08)],
+    [
+        ("controller", "ruckig"),
+        ("tracker_stiffness", 0.0),
+        ("max_lead", -1.0),
+        ("grasp_width", -0.01),
+        ("grasp_width", 0.08),
+        ("grasp_tolerance", 0.0),
+    ],
 )
 def test_bad_controller_settings_name_the_flag(field, value):
     from igen_lerobot.core.exceptions import ConfigError

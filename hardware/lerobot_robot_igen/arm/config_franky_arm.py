@@ -88,6 +88,7 @@ class FrankyArmConfig(ArmBackendConfig):
             "home_timeout",
             "home_tolerance",
             "connect_timeout",
+            "grasp_tolerance",
         ):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"--robot.{name} must be > 0, got {getattr(self, name)}")
