@@ -13,14 +13,16 @@
 # Block Grasp train at one torch thread, so two lanes' trainings share the two cores without the
 # collapse of two 2-thread pools and give the weights they would alone (docs/benchmarks.md).
 # franky runs in real time: while a lane's table drives franky-sim (a --rehearse table's franky
-# steps), that lane pauses the other lanes (SIGSTOP to their process groups, SIGCONT when franky-sim
-# ends or the lane dies). Measured: beside two niced trainings, franky at nice 0 lost every trial to
-# the watchdog; with one niced neighbour its clock ran at 0.75 of the wall's (docs/benchmarks.md).
-# Start each lane in a process group of its own (setsid), or it cannot be paused.
+# steps), that lane lowers the other lanes' sessions to nice 19 (autogroup, below) and gives them their
+# nice back when franky-sim ends or the lane dies. Measured: beside two niced trainings, franky at nice
+# 0 lost every trial to the watchdog; beside two lanes' sessions at nice 19 it ran as with them paused
+# (docs/benchmarks.md). The lanes used to pause each other (SIGSTOP), but a training resumed from a
+# pause can die of a corrupted heap (docs/benchmarks.md, "A paused training can die when it is resumed").
 # Linux's autogroup scheduling (on by default) shares the CPU between sessions first and applies nice
 # only within one: a lane started with setsid is a session of its own, so its nice alone would not
 # yield to a user's shell or CI (measured: two nice-10 lanes took 60% of the CPU from a test run). A
 # lane that leads its session gives the session its nice, and normal priority while its franky-sim runs.
+# Start each lane in a session of its own (setsid), or no other lane can lower it.
 #
 # block_grasp_randomized is the Block Grasp table generated on randomised arms (the data that
 # transfer, docs/benchmarks.md), rehearsed as it goes (igen-table --rehearse: each run of the paper's
@@ -88,15 +90,23 @@ locks=$root/.locks
 if [ "${DRY_RUN:-false}" != true ]; then
   mkdir -p "$locks"
   exec {lane}> "$locks/lane.$$" && flock "$lane"  # held while this lane lives
-  # this lane's process group, where other lanes find what to pause (empty: it shares its parent's)
-  [ "$(ps -o pgid= -p $$ | tr -d ' ')" = "$$" ] && echo "$$" > "$locks/lane.$$"
-  paused=$locks/paused_by.$$  # the groups this lane has paused, resumed whatever ends it
-  resume_paused() {
-    local group
-    [ -e "$paused" ] || return 0
-    while read -r group; do kill -CONT -- "-$group" 2>/dev/null || true; done < "$paused"
-    rm -f "$paused"
-    echo "$(date +%T) franky-sim ended: lanes resumed"
+  # this lane's session, where other lanes find what to lower (empty: it shares its parent's)
+  [ "$(ps -o sid= -p $$ | tr -d ' ')" = "$$" ] && echo "$$" > "$locks/lane.$$"
+  lowered=$locks/lowered_by.$$  # "<session> <its nice>" per lane this lane lowered, given back whatever ends it
+  set_autogroup_nice() {  # the kernel takes one autogroup change per 0.1 s (EAGAIN): try a few times
+    local try
+    for try in 1 2 3 4 5 6 7 8; do
+      echo "$2" 2>/dev/null > "/proc/$1/autogroup" && return 0
+      sleep 0.15
+    done
+    return 1
+  }
+  restore_lowered() {
+    local session nice
+    [ -e "$lowered" ] || return 0
+    while read -r session nice; do set_autogroup_nice "$session" "$nice" || true; done < "$lowered"
+    rm -f "$lowered"
+    echo "$(date +%T) franky-sim ended: lanes back to their nice"
   }
   drives_franky() {  # a franky-sim this lane started (it runs in a session of its own: found by ancestry)
     local pid up
@@ -109,43 +119,44 @@ if [ "${DRY_RUN:-false}" != true ]; then
     done
     return 1
   }
-  pause_others() {
-    local f group
+  lower_others() {
+    local f session nice
     for f in "$locks"/lane.*; do
       [ "$f" = "$locks/lane.$$" ] && continue
-      flock -n "$f" true 2>/dev/null && continue  # unlocked: a lane that died (its group may be reused)
-      group=$(cat "$f" 2>/dev/null || true)
-      if [ -z "$group" ]; then
-        echo "$(date +%T) cannot pause the lane of $f: not a process group of its own (start lanes with setsid)"
+      flock -n "$f" true 2>/dev/null && continue  # unlocked: a lane that died (its pid may be reused)
+      session=$(cat "$f" 2>/dev/null || true)
+      if [ -z "$session" ]; then
+        echo "$(date +%T) cannot lower the lane of $f: not a session of its own (start lanes with setsid)"
         continue
       fi
-      grep -qx "$group" "$paused" 2>/dev/null && continue
-      kill -STOP -- "-$group" 2>/dev/null && echo "$group" >> "$paused" \
-        && echo "$(date +%T) franky-sim runs in real time: lane $group paused"
+      grep -q "^$session " "$lowered" 2>/dev/null && continue
+      nice=$(cut -d' ' -f3 "/proc/$session/autogroup" 2>/dev/null || true)
+      [ -n "$nice" ] || continue  # gone since the check
+      set_autogroup_nice "$session" 19 && echo "$session $nice" >> "$lowered" \
+        && echo "$(date +%T) franky-sim runs in real time: lane $session lowered from nice $nice to 19"
     done
   }
   lane_nice=$(nice)
   set_session_nice() {  # only a lane that leads its session: else it would renice its user's shell
     [ "$(ps -o sid= -p $$ | tr -d ' ')" = "$$" ] && [ -w "/proc/$$/autogroup" ] || return 0
-    echo "$1" > "/proc/$$/autogroup" 2>/dev/null \
-      || echo "$(date +%T) cannot set this lane's session to nice $1 (/proc/$$/autogroup)"
+    set_autogroup_nice $$ "$1" || echo "$(date +%T) cannot set this lane's session to nice $1 (/proc/$$/autogroup)"
   }
   set_session_nice "$lane_nice"
-  ( # the watcher: other lanes pause while this lane's franky-sim lives
-    trap 'resume_paused; exit 0' TERM
+  ( # the watcher: other lanes run at nice 19 while this lane's franky-sim lives
+    trap 'restore_lowered; exit 0' TERM
     franky=false
     while sleep 1; do
       if drives_franky; then
-        pause_others
         $franky || { set_session_nice 0; franky=true; }
+        lower_others
       else
-        resume_paused
+        restore_lowered
         ! $franky || { set_session_nice "$lane_nice"; franky=false; }
       fi
     done
   ) &
   watcher=$!
-  trap 'kill $watcher 2>/dev/null; wait $watcher 2>/dev/null; resume_paused; rm -f "$locks/lane.$$"' EXIT
+  trap 'kill $watcher 2>/dev/null; wait $watcher 2>/dev/null; restore_lowered; rm -f "$locks/lane.$$"' EXIT
 fi
 for name in "${names[@]}"; do
   if [ -e "docs/results/$name.json" ] && [ ! -e "$root/$name/table_config.json" ] \
