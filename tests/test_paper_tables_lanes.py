@@ -21,13 +21,16 @@ case "$*" in
     bash -c 'exec -a "python tools/franky_sim/serve.py --stand-in" sleep {franky_seconds}'
     echo "franky-end $(date +%s.%N)" >> "{log}" ;;
   *)
-    for i in $(seq {ticks}); do echo "tick $(date +%s.%N) $(cut -d' ' -f3 /proc/self/autogroup)" >> "{log}"; sleep 0.1; done ;;
+    for i in $(seq {ticks}); do
+      echo "tick $(date +%s.%N) $(cut -d' ' -f3 /proc/self/autogroup)" >> "{log}"; sleep 0.1
+    done ;;
 esac
 """
 OTHER_LANE_NICE = 5
 
 needs_autogroup = pytest.mark.skipif(
-    not Path("/proc/self/autogroup").exists(), reason="this kernel has no autogroup scheduling: nice alone orders the lanes"
+    not Path("/proc/self/autogroup").exists(),
+    reason="this kernel has no autogroup scheduling: nice alone orders the lanes",
 )
 
 
