@@ -18,6 +18,8 @@ import subprocess
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
+from igen_lerobot.core.portable_math import pinned_paths
+
 REPO_ROOT = Path(__file__).resolve().parents[2]
 logger = logging.getLogger(__name__)
 
@@ -48,13 +50,20 @@ def _vector_units() -> str:
 
 
 def machine_identity() -> str:
-    """``"AMD EPYC, 2 cores, avx512f, torch 2.7.1"``: what a bit-identical rerun of a training step needs to match."""
+    """``"AMD EPYC, 2 cores, avx2, torch 2.7.1"``: what a bit-identical rerun of a training step needs to match.
+
+    A host whose widest unit is not AVX2 but whose steps run the portable AVX2 code paths
+    (:mod:`igen_lerobot.core.portable_math`) says so: ``"avx512f run as avx2"``.
+    """
     try:
         torch = version("torch")
     except PackageNotFoundError:
         torch = "not installed"
     cpu = _cpuinfo("model name") or platform.processor() or platform.machine()
-    return f"{cpu}, {os.cpu_count()} cores, {_vector_units()}, torch {torch}"
+    units = _vector_units()
+    if units != "avx2" and pinned_paths():
+        units = f"{units} run as avx2"
+    return f"{cpu}, {os.cpu_count()} cores, {units}, torch {torch}"
 
 
 def code_version() -> dict:

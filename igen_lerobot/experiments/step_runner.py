@@ -10,7 +10,6 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
-import os
 import resource
 import shlex
 import signal
@@ -23,6 +22,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import IgenError
+from igen_lerobot.core.portable_math import subprocess_env
 from igen_lerobot.experiments.ledger import DATA_FILE, REUSED_FILE, Ledger
 from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
 from igen_lerobot.experiments.training_reuse import dataset_digest, link_training, records_of_training
@@ -138,7 +138,7 @@ class StepRunner:
                     else:
                         with open(log, "a") as sink:
                             code = subprocess.run(
-                                ran, stdout=sink, stderr=subprocess.STDOUT, env={**os.environ, **env}
+                                ran, stdout=sink, stderr=subprocess.STDOUT, env=subprocess_env(env)
                             ).returncode
             except KeyboardInterrupt:
                 self.interrupted[name] = self.interrupted.get(name, 0.0) + time.perf_counter() - start
