@@ -104,7 +104,11 @@ if [ "${DRY_RUN:-false}" != true ]; then
   restore_lowered() {
     local session nice
     [ -e "$lowered" ] || return 0
-    while read -r session nice; do set_autogroup_nice "$session" "$nice" || true; done < "$lowered"
+    while read -r session nice; do
+      # only a lane still alive: a lane that ended since may have left its pid to another session
+      [ -e "$locks/lane.$session" ] && ! flock -n "$locks/lane.$session" true 2>/dev/null || continue
+      set_autogroup_nice "$session" "$nice" || true
+    done < "$lowered"
     rm -f "$lowered"
     echo "$(date +%T) franky-sim ended: lanes back to their nice"
   }
