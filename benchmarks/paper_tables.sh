@@ -106,8 +106,10 @@ if [ "${DRY_RUN:-false}" != true ]; then
     [ -e "$lowered" ] || return 0
     while read -r session nice; do
       # only a lane still alive: a lane that ended since may have left its pid to another session
-      [ -e "$locks/lane.$session" ] && ! flock -n "$locks/lane.$session" true 2>/dev/null || continue
-      set_autogroup_nice "$session" "$nice" || true
+      [ "$nice" != - ] && [ -e "$locks/lane.$session" ] && ! flock -n "$locks/lane.$session" true 2>/dev/null \
+        || continue
+      set_autogroup_nice "$session" "$nice" || echo "$(date +%T) cannot give lane $session its nice $nice back" \
+        "(raising a session's priority needs root or CAP_SYS_NICE): it stays at 19 until it ends"
     done < "$lowered"
     rm -f "$lowered"
     echo "$(date +%T) franky-sim ended: lanes back to their nice"
@@ -136,8 +138,13 @@ if [ "${DRY_RUN:-false}" != true ]; then
       grep -q "^$session " "$lowered" 2>/dev/null && continue
       nice=$(cut -d' ' -f3 "/proc/$session/autogroup" 2>/dev/null || true)
       [ -n "$nice" ] || continue  # gone since the check
-      set_autogroup_nice "$session" 19 && echo "$session $nice" >> "$lowered" \
-        && echo "$(date +%T) franky-sim runs in real time: lane $session lowered from nice $nice to 19"
+      if set_autogroup_nice "$session" 19; then
+        echo "$session $nice" >> "$lowered"
+        echo "$(date +%T) franky-sim runs in real time: lane $session lowered from nice $nice to 19"
+      else  # recorded as not lowered, so that it is tried once per franky-sim, not every second
+        echo "$session -" >> "$lowered"
+        echo "$(date +%T) cannot lower lane $session to nice 19 (/proc/$session/autogroup): franky may miss its watchdog"
+      fi
     done
   }
   lane_nice=$(nice)
@@ -146,6 +153,9 @@ if [ "${DRY_RUN:-false}" != true ]; then
     set_autogroup_nice $$ "$1" || echo "$(date +%T) cannot set this lane's session to nice $1 (/proc/$$/autogroup)"
   }
   set_session_nice "$lane_nice"
+  if [ "$(cat /proc/sys/kernel/sched_autogroup_enabled 2>/dev/null)" != 1 ]; then
+    echo "$(date +%T) autogroup scheduling is off here: lanes cannot lower each other while franky-sim runs"
+  fi
   ( # the watcher: other lanes run at nice 19 while this lane's franky-sim lives
     trap 'restore_lowered; exit 0' TERM
     franky=false
