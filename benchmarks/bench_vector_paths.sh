@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Does the vector unit change a training's weights? Three 40-step BC-RNN trainings (seed 1000, one
+# Does the vector unit change a training's weights? Four 40-step BC-RNN trainings (seed 1000, one
 # thread) on one small Block Grasp dataset, differing only in the code paths torch, MKL and oneDNN
-# may take: as installed, pinned to AVX2, forced to the generic paths, and igen-table's portable paths. Prints which weights are
-# identical to the plain ones, and a digest of each, so that two hosts can be compared
+# may take: as installed, pinned to AVX2, forced to the generic paths, and igen-table's portable
+# paths. Prints which weights are identical to the plain ones, and a digest of each, so that two
+# hosts can be compared
 # (docs/results/reproducibility.md). The demonstrations are made on the portable code paths
 # (igen_lerobot/core/portable_math.py), so every host trains on the same bytes.
 #

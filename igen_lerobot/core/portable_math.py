@@ -1,4 +1,4 @@
-"""One set of numeric code paths on every x86-64 host, so a table's steps make the same numbers anywhere.
+"""One set of numeric code paths on every x86-64 host, so that a table's datasets come out the same on each.
 
 OpenBLAS (numpy's linear algebra, which robosuite's controllers call every step), numpy's own loops,
 and torch's kernels, MKL and oneDNN each pick code for the CPU they find at run time. An AVX-512
@@ -8,6 +8,8 @@ another digest than the one made on an AMD EPYC (avx2); made with these settings
 host's, byte for byte (docs/results/reproducibility.md). Every step ``igen-table`` starts runs with
 them; on the AMD EPYC (avx2) hosts the earlier tables were made on, they give the numbers the
 libraries' own choice gave (that same digest; torch's: ``benchmarks/bench_vector_paths.sh``).
+Trainings still differ between an Intel avx512f and an AMD host with these settings: what a trained
+policy generates is not yet the same across them.
 
 The settings are read when each library loads, so they must be in a process's environment when it
 starts: they are given to subprocesses, never set in a running one.

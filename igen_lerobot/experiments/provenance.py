@@ -18,7 +18,7 @@ import subprocess
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from igen_lerobot.core.portable_math import pinned_paths
+from igen_lerobot.core.portable_math import cpu_flags, pinned_paths
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 logger = logging.getLogger(__name__)
@@ -45,7 +45,7 @@ def _cpuinfo(field: str) -> str | None:
 
 def _vector_units() -> str:
     """The widest x86 vector extension the CPU has: PyTorch's CPU kernels (and their rounding) follow it."""
-    flags = (_cpuinfo("flags") or "").split()
+    flags = cpu_flags()
     return next((unit for unit in ("avx512f", "avx2", "sse4_2") if unit in flags), platform.machine())
 
 
