@@ -18,6 +18,7 @@ import logging
 import numpy as np
 
 from igen_lerobot.core.env_config import task_config_class
+from igen_lerobot.core.portable_math import rerun_on_portable_paths
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.trials import rollout
 from igen_lerobot.training.policy_source import make_base_policy
@@ -77,6 +78,7 @@ def main() -> None:
     parser.add_argument("--trial", type=int, default=0)
     parser.add_argument("--tol", type=float, default=1e-4)
     args = parser.parse_args()
+    rerun_on_portable_paths()
     logging.basicConfig(level=logging.WARNING)
     flags = [f"--policy.path={args.checkpoint}", "--robot.type=sim", "--perception.type=truth"]
     cfg = draccus.parse(DeployConfig, args=[*flags, f"--trials={args.trial + 1}"])

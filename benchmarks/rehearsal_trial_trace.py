@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from igen_lerobot.core.portable_math import rerun_on_portable_paths
+
 
 def step_row(rec) -> dict:
     """The parts of a loop period that tell a recovery apart from a stall (world frame, metres)."""
@@ -100,6 +102,7 @@ def main() -> None:
         return
     if not args.checkpoint or not args.out:
         parser.error("give CHECKPOINT and --out (or --compare A B)")
+    rerun_on_portable_paths()  # the trace must compute what the table's rehearsal step did
     result = trace(args.checkpoint, args.trial, args.deploy_flags)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=1))

@@ -21,7 +21,8 @@ began, and (a recurrent policy with a ``horizon``) how many of them began at a h
 that reads wider fingers as the release phase goes on opening.
 
 A rerun trial must end as the report says: a mismatch is printed and counted, so a table's reading
-never rests on trials that did not replay.
+never rests on trials that did not replay. The script runs on the code paths the table's steps ran on
+(``igen_lerobot.core.portable_math``): on an AVX-512 host its own paths end 1-3 of 50 trials otherwise.
 
 Run:  .venv/bin/python benchmarks/trial_outcomes.py REPORT.json [REPORT.json ...] [--trials 50]
 """
@@ -36,6 +37,7 @@ from pathlib import Path
 import numpy as np
 from lerobot.utils.import_utils import register_third_party_plugins
 
+from igen_lerobot.core.portable_math import rerun_on_portable_paths
 from igen_lerobot.core.recorder import EpisodeRecorder
 from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.evaluation.evaluate import report_env_config
@@ -136,6 +138,7 @@ def main() -> None:
     parser.add_argument("reports", nargs="+", type=Path)
     parser.add_argument("--trials", type=int, default=None, help="only the first N trials of each report")
     args = parser.parse_args()
+    rerun_on_portable_paths()
     register_third_party_plugins()
     for path in args.reports:
         print(json.dumps(trial_outcomes(path, args.trials)))

@@ -1,10 +1,12 @@
 """A table's steps run one set of numeric code paths on every x86-64 host (docs/results/reproducibility.md)."""
 
 import json
+import os
+import subprocess
 import sys
 from pathlib import Path
 
-from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, portable_math_env
+from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, portable_math_env
 from igen_lerobot.experiments import provenance
 from igen_lerobot.experiments.step_runner import StepRunner
 
@@ -69,3 +71,51 @@ def test_a_step_record_names_a_wider_host_run_as_avx2(monkeypatch):
     monkeypatch.setattr(provenance, "_vector_units", lambda: "avx2")
     monkeypatch.setattr(provenance, "pinned_paths", lambda: True)
     assert ", avx2, torch " in provenance.machine_identity()  # an AVX2 host's record is as before
+
+
+# a replay script: starts itself again on the portable paths, then reports what it runs on
+REPLAY_SCRIPT = """
+import json, os, sys
+from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, rerun_on_portable_paths
+rerun_on_portable_paths()
+import torch
+json.dump({
+    "env": {name: os.environ.get(name) for name in PORTABLE_MATH_ENV},
+    "rerun": os.environ.get(RERUN_MARK),
+    "argv": sys.argv[1:],
+    "torch": torch.backends.cpu.get_cpu_capability(),
+}, open(sys.argv[1], "w"))
+"""
+
+
+def _replay(tmp_path: Path, **env: str) -> dict:
+    done = tmp_path / "replay.json"
+    script = tmp_path / "replay.py"
+    script.write_text(REPLAY_SCRIPT)
+    clean = {k: v for k, v in os.environ.items() if k not in PORTABLE_MATH_ENV and k != RERUN_MARK}
+    command = [sys.executable, "-B", str(script), str(done), "--trial", "3"]
+    # a loop of restarts would hang: the timeout fails the test instead
+    subprocess.run(command, env={**clean, **env}, check=True, timeout=120)
+    return json.loads(done.read_text())
+
+
+def test_a_replay_script_starts_again_on_the_portable_paths_with_its_arguments(tmp_path):
+    seen = _replay(tmp_path)
+    assert seen["argv"] == [str(tmp_path / "replay.json"), "--trial", "3"]
+    if not portable_math_env():  # nothing to pin: the script runs as started, once
+        assert seen["rerun"] is None and seen["env"] == dict.fromkeys(PORTABLE_MATH_ENV)
+        return
+    assert seen["rerun"] == "1" and seen["env"] == PORTABLE_MATH_ENV, seen
+    assert seen["torch"] == "AVX2", seen
+
+
+def test_a_replay_script_started_on_the_portable_paths_is_not_started_again(tmp_path):
+    seen = _replay(tmp_path, **PORTABLE_MATH_ENV)
+    assert seen["rerun"] is None and seen["env"] == PORTABLE_MATH_ENV
+
+
+def test_a_replay_script_keeps_a_code_path_the_user_sets_and_starts_again_only_once(tmp_path):
+    seen = _replay(tmp_path, OPENBLAS_CORETYPE="Sandybridge")
+    assert seen["env"]["OPENBLAS_CORETYPE"] == "Sandybridge"
+    if portable_math_env():
+        assert seen["rerun"] == "1" and seen["env"]["ATEN_CPU_CAPABILITY"] == "avx2", seen

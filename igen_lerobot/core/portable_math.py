@@ -12,13 +12,17 @@ Trainings still differ between an Intel avx512f and an AMD host with these setti
 policy generates is not yet the same across them.
 
 The settings are read when each library loads, so they must be in a process's environment when it
-starts: they are given to subprocesses, never set in a running one.
+starts: they are given to subprocesses, never set in a running one. A script that replays a table's
+trials starts itself again with them (:func:`rerun_on_portable_paths`): on an AVX-512 host a replay on
+the host's own paths ends 1-3 of 50 trials otherwise than the table's report.
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import platform
+import sys
 from pathlib import Path
 
 # the AVX2 generation of each library's kernels (Haswell: OpenBLAS's name for AVX2 + FMA)
@@ -31,6 +35,8 @@ PORTABLE_MATH_ENV = {
 }
 # what the pinned kernels need: forcing OpenBLAS's Haswell kernels on a CPU without them would fault
 REQUIRED_FLAGS = ("avx2", "fma")
+# set in a process started again by rerun_on_portable_paths, so it is started again at most once
+RERUN_MARK = "IGEN_PORTABLE_MATH_RERUN"
 
 
 def cpu_flags(cpuinfo: Path = Path("/proc/cpuinfo")) -> set[str]:
@@ -68,6 +74,22 @@ def pinned_paths(env: dict[str, str] | None = None) -> bool:
     """Whether a subprocess given ``env`` (default: :func:`subprocess_env`) runs every pinned path."""
     env = subprocess_env() if env is None else env
     return all(env.get(name) == value for name, value in PORTABLE_MATH_ENV.items())
+
+
+def rerun_on_portable_paths() -> None:
+    """Start this script again (same interpreter, flags and arguments) with the portable settings.
+
+    For scripts that replay a table's steps (its trials, its rehearsals): they must compute what the
+    step computed. Returns at once where the settings are in place already, where the host has none,
+    or in the process started again (a setting the user chose wins there, as in :func:`subprocess_env`).
+    Call it before the work starts: what the process did before is done again.
+    """
+    if not portable_math_env() or pinned_paths(dict(os.environ)) or os.environ.get(RERUN_MARK):
+        return
+    logging.getLogger(__name__).info("starting again on the tables' code paths (%s)", " ".join(PORTABLE_MATH_ENV))
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.execve(sys.executable, list(sys.orig_argv), subprocess_env({RERUN_MARK: "1"}))
 
 
 def main() -> None:
