@@ -119,3 +119,8 @@ def test_a_replay_script_keeps_a_code_path_the_user_sets_and_starts_again_only_o
     assert seen["env"]["OPENBLAS_CORETYPE"] == "Sandybridge"
     if portable_math_env():
         assert seen["rerun"] == "1" and seen["env"]["ATEN_CPU_CAPABILITY"] == "avx2", seen
+
+
+def test_a_replay_script_told_to_stay_keeps_the_hosts_own_paths(tmp_path):
+    seen = _replay(tmp_path, **{RERUN_MARK: "1"})
+    assert seen["env"] == dict.fromkeys(PORTABLE_MATH_ENV), seen  # not started again with the settings

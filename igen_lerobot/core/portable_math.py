@@ -23,6 +23,7 @@ import logging
 import os
 import platform
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 # the AVX2 generation of each library's kernels (Haswell: OpenBLAS's name for AVX2 + FMA)
@@ -35,7 +36,8 @@ PORTABLE_MATH_ENV = {
 }
 # what the pinned kernels need: forcing OpenBLAS's Haswell kernels on a CPU without them would fault
 REQUIRED_FLAGS = ("avx2", "fma")
-# set in a process started again by rerun_on_portable_paths, so it is started again at most once
+# set in a process started again by rerun_on_portable_paths, so it is started again at most once;
+# set it by hand to replay on the host's own code paths instead
 RERUN_MARK = "IGEN_PORTABLE_MATH_RERUN"
 
 
@@ -70,7 +72,7 @@ def subprocess_env(extra: dict[str, str] | None = None) -> dict[str, str]:
     return {**portable_math_env(), **os.environ, **(extra or {})}
 
 
-def pinned_paths(env: dict[str, str] | None = None) -> bool:
+def pinned_paths(env: Mapping[str, str] | None = None) -> bool:
     """Whether a subprocess given ``env`` (default: :func:`subprocess_env`) runs every pinned path."""
     env = subprocess_env() if env is None else env
     return all(env.get(name) == value for name, value in PORTABLE_MATH_ENV.items())
@@ -84,7 +86,7 @@ def rerun_on_portable_paths() -> None:
     or in the process started again (a setting the user chose wins there, as in :func:`subprocess_env`).
     Call it before the work starts: what the process did before is done again.
     """
-    if not portable_math_env() or pinned_paths(dict(os.environ)) or os.environ.get(RERUN_MARK):
+    if not portable_math_env() or pinned_paths(os.environ) or os.environ.get(RERUN_MARK):
         return
     logging.getLogger(__name__).info("starting again on the tables' code paths (%s)", " ".join(PORTABLE_MATH_ENV))
     sys.stdout.flush()
