@@ -6,8 +6,9 @@ host therefore simulates, generates and trains other numbers than an AVX2 host f
 command: the 2-Piece base dataset (1000 MimicGen episodes) made on an Intel Xeon with avx512f had
 another digest than the one made on an AMD EPYC (avx2); made with these settings it had the AMD
 host's, byte for byte (docs/results/reproducibility.md). Every step ``igen-table`` starts runs with
-them; on the AMD EPYC (avx2) hosts the earlier tables were made on, they give the numbers the
-libraries' own choice gave (that same digest; torch's: ``benchmarks/bench_vector_paths.sh``).
+them, and every ``igen-*`` command starts itself again with them (``scripts/console.py``); on the
+AMD EPYC (avx2) hosts the earlier tables were made on, they give the numbers the libraries' own
+choice gave (that same digest; torch's: ``benchmarks/bench_vector_paths.sh``).
 Trainings still differ between an Intel avx512f and an AMD host with these settings: what a trained
 policy generates is not yet the same across them.
 

@@ -28,10 +28,14 @@ def find_igen_error(error: BaseException) -> IgenError | None:
 def run_cli(config_class: type, command: Callable[..., object], prog: str) -> None:
     """Parse the command line into ``config_class`` and run ``command`` on it.
 
-    Parsing follows LeRobot's (plugin discovery flags, ``--config_path``, scoped ``--help``), with
+    It runs on the tables' code paths (``scripts/console.py``). Parsing follows LeRobot's (plugin
+    discovery flags, ``--config_path``, scoped ``--help``), with
     one difference: when a config check of ours fails deep inside draccus (an env config inside a
     union, say), the user sees our message with its fix, not draccus's "could not decode".
     """
+    from igen_lerobot.core.portable_math import rerun_on_portable_paths
+
+    rerun_on_portable_paths()  # started as `python -m igen_lerobot.scripts...`: the console commands did already
     from lerobot.utils.utils import init_logging
 
     from igen_lerobot.core.plugins import discover_plugins

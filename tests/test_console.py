@@ -1,0 +1,104 @@
+"""Every igen command runs on the tables' code paths, as a table's steps do (docs/results/reproducibility.md)."""
+
+import json
+import os
+import subprocess
+import sys
+import tomllib
+from importlib import import_module
+from importlib.metadata import entry_points
+from importlib.util import find_spec
+from pathlib import Path
+
+import pytest
+
+from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, portable_math_env
+from igen_lerobot.scripts import console
+
+ROOT = Path(__file__).resolve().parents[1]
+PYPROJECTS = [ROOT / "pyproject.toml", ROOT / "hardware" / "pyproject.toml"]
+
+
+def _declared_commands() -> dict[str, str]:
+    commands = {}
+    for pyproject in PYPROJECTS:
+        commands.update(tomllib.loads(pyproject.read_text())["project"]["scripts"])
+    return commands
+
+
+def test_every_igen_command_goes_through_a_console_entry_that_starts_a_real_script(monkeypatch):
+    commands = _declared_commands()
+    assert {"igen-eval", "igen-generate", "igen-collect", "igen-table", "igen-deploy"} <= set(commands)
+    for name, target in commands.items():
+        module_name, function_name = target.split(":")
+        assert module_name.endswith(".console"), f"{name} = {target}: not started on the portable paths"
+        started = []
+        entry_module = import_module(module_name)
+        monkeypatch.setattr(entry_module, "start", started.append)
+        getattr(entry_module, function_name)()
+        assert len(started) == 1 and find_spec(started[0]) is not None, (name, started)
+        assert started[0].rsplit(".", 1)[1] == name.replace("-", "_"), (name, started)
+
+
+def test_the_installed_commands_are_the_declared_ones():
+    """A venv installed before the console entries would run the scripts on the host's own paths."""
+    installed = {ep.name: ep.value for ep in entry_points(group="console_scripts") if ep.name.startswith("igen-")}
+    assert installed == _declared_commands(), "run scripts/setup.sh (uv sync) to install the commands again"
+
+
+# a script a console entry runs: reports the code paths and arguments it ran with
+PROBE = """
+import json, os, sys
+import torch
+from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK
+
+def main():
+    json.dump({
+        "env": {name: os.environ.get(name) for name in PORTABLE_MATH_ENV},
+        "rerun": os.environ.get(RERUN_MARK),
+        "argv": sys.argv[1:],
+        "torch": torch.backends.cpu.get_cpu_capability(),
+    }, open(sys.argv[1], "w"))
+"""
+
+
+def _run_command(tmp_path: Path, **env: str) -> dict:
+    (tmp_path / "igen_probe_script.py").write_text(PROBE)
+    done = tmp_path / "probe.json"
+    clean = {k: v for k, v in os.environ.items() if k not in PORTABLE_MATH_ENV and k != RERUN_MARK}
+    clean["PYTHONPATH"] = os.pathsep.join([str(tmp_path), *sys.path])
+    starter = "from igen_lerobot.scripts.console import start; start('igen_probe_script')"
+    # a loop of restarts would hang: the timeout fails the test instead
+    subprocess.run(
+        [sys.executable, "-B", "-c", starter, str(done), "--n_trials", "5"],
+        env={**clean, **env},
+        check=True,
+        timeout=120,
+    )
+    return json.loads(done.read_text())
+
+
+def test_a_command_runs_its_script_on_the_portable_paths_with_its_arguments(tmp_path):
+    seen = _run_command(tmp_path)
+    assert seen["argv"] == [str(tmp_path / "probe.json"), "--n_trials", "5"]
+    if not portable_math_env():  # nothing to pin on this host: run as started, once
+        assert seen["rerun"] is None and seen["env"] == dict.fromkeys(PORTABLE_MATH_ENV)
+        return
+    assert seen["rerun"] == "1" and seen["env"] == PORTABLE_MATH_ENV, seen
+    assert seen["torch"] == "AVX2", seen
+
+
+@pytest.mark.parametrize("stay", [{RERUN_MARK: "1"}, PORTABLE_MATH_ENV])
+def test_a_command_told_to_stay_or_already_pinned_is_not_started_again(tmp_path, stay):
+    seen = _run_command(tmp_path, **stay)
+    assert seen["rerun"] == stay.get(RERUN_MARK)
+    assert seen["env"] == {name: stay.get(name) for name in PORTABLE_MATH_ENV}
+
+
+def test_the_console_module_imports_nothing_heavy():
+    """The restart must come before torch and robosuite load, or a command pays their import twice."""
+    heavy = "{'torch', 'robosuite', 'lerobot', 'mujoco'}"
+    code = f"import sys, igen_lerobot.scripts.console; print(sorted({heavy} & set(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", out
+    assert console.start.__module__ == "igen_lerobot.scripts.console"
