@@ -102,3 +102,28 @@ def test_the_console_module_imports_nothing_heavy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]", out
     assert console.start.__module__ == "igen_lerobot.scripts.console"
+
+
+# a table or a test that runs a command's entry point inside its own process (--in_process=true)
+IN_PROCESS = """
+import sys
+from pathlib import Path
+from igen_lerobot.experiments.step_runner import _run_in_process
+print("started", flush=True)
+print("returned", _run_in_process(["igen-merge", "--help"], Path(sys.argv[1]), {}), flush=True)
+"""
+
+
+def test_a_command_run_inside_another_process_does_not_start_that_process_again(tmp_path):
+    clean = {k: v for k, v in os.environ.items() if k not in PORTABLE_MATH_ENV and k != RERUN_MARK}
+    done = subprocess.run(
+        [sys.executable, "-c", IN_PROCESS, str(tmp_path / "merge.log")],
+        env=clean,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    )
+    # started again, the caller would print "started" twice (and on a host with nothing to pin, once anyway)
+    assert done.stdout.split("\n")[:2] == ["started", "returned 0"], done.stdout + done.stderr
+    assert "--inputs" in (tmp_path / "merge.log").read_text()  # the command did run: its help went to the log
