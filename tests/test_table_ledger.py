@@ -1,5 +1,5 @@
 """A table survives the loss of its machine: the ledger keeps each finished step's small records,
-and a run on an empty output folder restores them and trains only what generation needs again."""
+and a run on an empty output folder restores them and makes only what its unfinished rows need."""
 
 import json
 import shutil
@@ -11,51 +11,68 @@ from igen_lerobot.experiments.checkpoint_choice import chosen_checkpoint
 from igen_lerobot.experiments.ledger import STEP_RECORDS, Ledger
 
 
-def test_a_table_on_a_new_machine_restores_its_ledger_and_retrains_only_the_data_policy(tmp_path, tiny_table):
+def test_a_table_on_a_new_machine_restores_its_ledger_and_makes_only_what_unfinished_rows_need(tmp_path, tiny_table):
     out, ledger, results = tmp_path / "table", tmp_path / "ledger", tmp_path / "results.md"
-    flags = ("--variants=[base]", "--train_seeds=[7,8]", "--train.save_freq=1", f"--ledger_dir={ledger}")
+    flags = ("--variants=[base,source_int]", "--train_seeds=[7,8]", "--train.save_freq=1", f"--ledger_dir={ledger}")
     first = tiny_table(out, results, *flags)
     assert first.returncode == 0, first.stderr[-4000:]
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
 
-    # the ledger holds the evaluation reports, the step records and the config: no dataset, no checkpoint
+    # the ledger holds the evaluation reports, the step records, the config and the datasets' sizes:
+    # no dataset, no checkpoint
     kept = {p.relative_to(ledger).as_posix() for p in ledger.rglob("*") if p.is_file()}
-    assert {"table_config.json", *STEP_RECORDS[:3]} <= kept
-    for seed in (7, 8):
-        assert f"eval/base/seed{seed}/validation.json" in kept
-        step = next(s["chosen_step"] for s in report["rows"][0]["seeds"] if s["seed"] == seed)
-        assert f"eval/base/seed{seed}/test_step{step}.json" in kept
+    assert {"table_config.json", "dataset_sizes.json", *STEP_RECORDS[:3]} <= kept
+    for row in report["rows"]:
+        for seed in (7, 8):
+            assert f"eval/{row['variant']}/seed{seed}/validation.json" in kept
+            step = next(s["chosen_step"] for s in row["seeds"] if s["seed"] == seed)
+            assert f"eval/{row['variant']}/seed{seed}/test_step{step}.json" in kept
     assert not any(k.startswith(("data/", "train/", "logs/")) for k in kept), kept
     recorded = json.loads((ledger / "step_times.json").read_text())
     assert recorded == json.loads((out / "step_times.json").read_text())
 
-    # the machine is lost: only the ledger is left
+    # the machine is lost with every row on record: only D is made again (every row trains with it),
+    # not the base policy, not the interventions it collects, not their merge
     shutil.rmtree(out)
     again = tiny_table(out, results, *flags)
     assert again.returncode == 0, again.stderr[-4000:]
+    assert {p.name for p in (out / "logs").glob("*.log")} == {"source_demos.log", "base.log"}
+    assert not (out / "train").exists() and not (out / "data" / "source_int").exists()
     resumed = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
-    # seed 8's numbers are read back from the ledger; it is neither trained nor evaluated again
-    assert not (out / "train" / "base" / "seed8").exists()
-    assert not any((out / "logs").glob("*seed8*"))
-    # seed 7's base policy is trained again (generation runs it), its evaluation read back
-    assert (out / "train" / "base" / "seed7").is_dir()
-    assert (out / "logs" / "train_base_seed7.log").exists()
-    assert not (out / "logs" / "validate_base_seed7.log").exists()
-    assert resumed["rows"][0]["seeds"] == report["rows"][0]["seeds"]
+    assert resumed["rows"] == report["rows"]  # the seeds' numbers and the datasets' sizes, read back
+    # the protocol is recorded whole, and the steps not made again keep the times that made them
+    assert [c["step"] for c in resumed["commands"]] == [c["step"] for c in report["commands"]]
     times = json.loads((out / "step_times.json").read_text())
-    # the evaluation steps and seed 8's training keep the times that made them; the steps made again
-    # (datasets, seed 7's base policy) record this making's, not the lost one's plus it
-    for step in ("validate_base_seed7", "test_base_seed7", "train_base_seed8", "validate_base_seed8"):
+    for step in ("train_base_seed7", "source_int", "merge_source_int", "train_source_int_seed8", "test_base_seed7"):
         assert times[step] == recorded[step], step
-    for step in ("source_demos", "base", "train_base_seed7"):
+    for step in ("source_demos", "base"):
         assert times[step] != recorded[step], step
-    assert json.loads((ledger / "step_times.json").read_text()) == times
 
-    # a rehearsal reads the chosen checkpoints: missing, they are named with the flag that makes them again
+    # lost again, and Source Int seed 8's evaluation never reached the ledger: that row's data are made
+    # again, with the base policy that collects them; what is on record is not
+    shutil.rmtree(out)
+    shutil.rmtree(ledger / "eval" / "source_int" / "seed8")
+    third = tiny_table(out, results, *flags)
+    assert third.returncode == 0, third.stderr[-4000:]
+    logs = {p.name for p in (out / "logs").glob("*.log")}
+    made = {"train_base_seed7", "source_int", "merge_source_int", "train_source_int_seed8", "validate_source_int_seed8"}
+    assert {f"{step}.log" for step in made} <= logs
+    assert not logs & {f"{step}.log" for step in ("train_base_seed8", "validate_base_seed7", "train_source_int_seed7")}
+    times = json.loads((out / "step_times.json").read_text())
+    for step in made:
+        assert times[step] != recorded[step], step  # this making's time, not the lost one's plus it
+    assert times["validate_source_int_seed7"] == recorded["validate_source_int_seed7"]
+    assert json.loads((ledger / "step_times.json").read_text()) == times
+    resumed = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
+
+    # a rehearsal reads the chosen checkpoints: missing, they are named with the flag that makes them
+    # again, which makes every row's data again too (here without any: the datasets are gone as well)
     with pytest.raises(ConfigError, match="--retrain_restored=true"):
         chosen_checkpoint(out, "base", 8)
-    third = tiny_table(out, results, *flags, "--retrain_restored=true")
-    assert third.returncode == 0, third.stderr[-4000:]
+    shutil.rmtree(out / "data")
+    fourth = tiny_table(out, results, *flags, "--retrain_restored=true")
+    assert fourth.returncode == 0, fourth.stderr[-4000:]
+    assert (out / "data" / "train_source_int" / "meta" / "igen.json").exists()
     step, checkpoint = chosen_checkpoint(out, "base", 8)
     assert (checkpoint / "config.json").exists()
     assert (out / "logs" / "train_base_seed8.log").exists() and not (out / "logs" / "validate_base_seed8.log").exists()
@@ -97,8 +114,8 @@ def test_the_ledger_keeps_only_small_records_and_never_overwrites_a_local_one(tm
 
 def test_a_rehearsing_table_keeps_each_runs_rehearsal_and_trains_again_only_the_unrehearsed(tmp_path, tiny_table):
     """--rehearse: each run is rehearsed as it is tested, its reports kept in the ledger, so on a new machine
-    only a run whose rehearsal is not on record (and the data policy) is trained again, and nothing is
-    rehearsed twice."""
+    only a run whose rehearsal is not on record (and the data policy, where data still to make need it) is
+    trained again, and nothing is rehearsed twice."""
     out, ledger, results = tmp_path / "table", tmp_path / "ledger", tmp_path / "results.md"
     flags = (
         "--variants=[base]",
@@ -135,7 +152,8 @@ def test_a_rehearsing_table_keeps_each_runs_rehearsal_and_trains_again_only_the_
     # seed 8 is trained again for its weights, and only its missing path runs; its evaluation stands
     assert {"train_base_seed8.log", "rehearse_rendered_base_seed8.log"} <= logs
     assert not logs & {"validate_base_seed8.log", "test_base_seed8.log", "rehearse_eval_base_seed8.log"}
-    # seed 7 is trained again for the data it generates, but rehearsed no more: its reports are on record
+    # seed 7 is neither trained again (no dataset of a Base-only table runs a policy) nor rehearsed
+    assert "train_base_seed7.log" not in logs
     assert not any(name.startswith("rehearse_") and "seed7" in name for name in logs)
     resumed = json.loads((tmp_path / "results" / "block_grasp_rehearsal.json").read_text())
     assert [(r["variant"], r["path"], r["trials"]) for r in resumed["results"]] == [

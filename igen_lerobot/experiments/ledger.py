@@ -4,8 +4,8 @@ A paper table runs for hours across sessions; its output folder (datasets, check
 GB and lives on one machine. What its published numbers rest on is small: the evaluation reports
 and each step's time and commit. The ledger copies those, as each step finishes, into a folder that
 is kept in version control (``docs/results/ledger/<table>``), and a run on a new machine restores
-them first: every training seed whose evaluation is on record is not trained again, and only what
-the records do not hold (datasets, the policy the data are generated with) is made again.
+them first: every training seed whose evaluation is on record is not trained again, and only the
+datasets the rows still to run need (and the policy that generates them, where one does) are made again.
 """
 
 from __future__ import annotations
@@ -32,7 +32,8 @@ STEP_RECORDS = (
 )
 # the run's own settings, and the folders of its evaluation and rehearsal reports (JSON files in them):
 # what else the ledger keeps
-KEPT_FILES = ("table_config.json",)
+SIZES_FILE = "dataset_sizes.json"  # row -> the size of the dataset it trained on (what the page shows)
+KEPT_FILES = ("table_config.json", SIZES_FILE)
 KEPT_FOLDERS = ("eval", "rehearsal")
 
 

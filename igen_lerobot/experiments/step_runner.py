@@ -102,8 +102,12 @@ class StepRunner:
         execute: list[str] | Callable[[], list[str]] | None = None,
         env: dict[str, str] | None = None,
         reads: Path | None = None,
+        on_record: bool = False,
     ) -> None:
         """Run ``command`` unless ``done`` exists; its output is appended to ``logs/<name>.log``.
+
+        ``on_record``: the step is recorded (its command, and its times from the ledger) but not run:
+        nothing still to run needs its output (a dataset of a table's finished rows, on a new machine).
 
         ``execute``, when given, is what actually runs (a training resumed from its checkpoint), or a
         function that says so when it runs, while ``command`` is what the table records: the command
@@ -120,6 +124,9 @@ class StepRunner:
             return
         if done.exists():
             logger.info("%s: done already (%s)", name, done)
+            return
+        if on_record:
+            logger.info("%s: on record, and nothing still to run needs it", name)
             return
         log = self.out / "logs" / f"{name}.log"
         log.parent.mkdir(parents=True, exist_ok=True)

@@ -38,7 +38,7 @@ from igen_lerobot.experiments.checkpoint_choice import (
 )
 from igen_lerobot.experiments.config_rehearsal import PATHS
 from igen_lerobot.experiments.config_table import EARLIER_VALUES, TableConfig
-from igen_lerobot.experiments.ledger import Ledger
+from igen_lerobot.experiments.ledger import SIZES_FILE, Ledger
 from igen_lerobot.experiments.rehearsal import report_path
 from igen_lerobot.experiments.step_runner import StepRunner
 from igen_lerobot.experiments.table_rehearsal import FOLDER as REHEARSAL_FOLDER
@@ -106,8 +106,23 @@ class TableRun(StepRunner):
         # column whose validation trials choose the checkpoints
         self.columns = dict(paper.columns) if paper is not None else {}
         self.choose_on = paper.choose_on if paper is not None else ""
+        # row -> episodes and frames of its training dataset, kept in the ledger: a row whose runs are all
+        # on record needs neither its dataset nor its size made again on a new machine
+        self.sizes_file = self.out / SIZES_FILE
+        self.dataset_sizes: dict[str, dict] = (
+            json.loads(self.sizes_file.read_text()) if self.sizes_file.exists() else {}
+        )
         if not cfg.dry_run:
             self.ledger.keep(self.out / "table_config.json")
+
+    def record_size(self, variant: str, dataset: Path) -> None:
+        """Note the size of the dataset ``variant`` trains on, here and in the ledger."""
+        info = json.loads((dataset / "meta" / "info.json").read_text())
+        size = {"episodes": info["total_episodes"], "frames": info["total_frames"]}
+        if self.dataset_sizes.get(variant) != size:
+            self.dataset_sizes[variant] = size
+            self.sizes_file.write_text(json.dumps(self.dataset_sizes, indent=2))
+            self.ledger.keep(self.sizes_file)
 
 
 def _complete(root: Path) -> Path:
@@ -160,24 +175,66 @@ def _as_recorded(value):
     return json.loads(json.dumps(asdict(value) if is_dataclass(value) else value))
 
 
-def build_step(run: TableRun, step: DataStep, policy: str) -> None:
-    """Make one dataset of the table of steps (skipped when it is complete)."""
+def build_step(run: TableRun, step: DataStep, policy: str, on_record: bool = False) -> None:
+    """Make one dataset of the table of steps (skipped when it is complete, or ``on_record``)."""
     env = env_args(run.cfg) + (run.cfg.randomize if step.tool == "igen-generate" else [])
     run.run(
         step.name,
         run.igen(step.tool, *step.command(run.cfg, run.data, env, policy)),
         _complete(run.data(step.name)),
+        on_record=on_record,
     )
 
 
+def rows_to_run(cfg: TableConfig, columns: dict, sizes: dict) -> list[str]:
+    """The rows that still need their dataset here: a run not on record, or no record of the dataset's size.
+
+    Every row does when the table trains its restored runs again (``--retrain_restored``).
+    """
+    if cfg.retrain_restored:
+        return list(cfg.variants)
+    out = Path(cfg.output_dir)
+    return [
+        variant
+        for variant in cfg.variants
+        if variant not in sizes or not all(run_on_record(cfg, out, columns, variant, seed) for seed in cfg.train_seeds)
+    ]
+
+
+def data_policy_step(cfg: TableConfig) -> str:
+    """The training step of the base policy that generation runs: the first seed's."""
+    return f"train_base_seed{(cfg.train_seeds or [cfg.train.seed])[0]}"
+
+
+def steps_made_here(cfg: TableConfig, derived: dict, to_run: list[str]) -> set[str]:
+    """The dataset steps (and the base policy's training) that the rows ``to_run`` need made on this machine."""
+    parts = needed_parts(to_run, derived=derived)
+    merges = {
+        f"merge_{variant}"
+        for variant in to_run
+        if variant_part(variant, derived) is not None and trains_with_base(variant, derived)
+    }
+    policy = [data_policy_step(cfg)] if any(step.policy for step in parts) else []
+    return {*(step.name for step in (*BASE_STEPS, *parts)), *merges, *policy}
+
+
 def build_datasets(run: TableRun) -> dict[str, Path]:
-    """Collect, generate and merge everything the chosen variants need; returns their training datasets."""
+    """Collect, generate and merge what the rows still to run need; returns every row's training dataset.
+
+    D is always made (every row trains with it, the base policy on it). The datasets of rows whose runs
+    and dataset size are all on record (restored from the ledger on a new machine) are not made
+    again, nor is the base policy when no dataset still to make runs it: their steps are recorded with
+    the ledger's times. A dry run lists every step.
+    """
     cfg = run.cfg
+    to_run = list(cfg.variants) if run.dry_run else rows_to_run(cfg, run.columns, run.dataset_sizes)
+    made = steps_made_here(cfg, run.derived, to_run)
     for step in BASE_STEPS:
         build_step(run, step, policy="")
-    base_policy = str(train(run, "base", run.data("base"), cfg.train_seeds[0], weights_needed=True))
+    policy_step = data_policy_step(cfg)
+    base_policy = str(train(run, "base", run.data("base"), cfg.train_seeds[0], weights_needed=policy_step in made))
     for step in needed_parts(cfg.variants, derived=run.derived):
-        build_step(run, step, base_policy)
+        build_step(run, step, base_policy, on_record=step.name not in made)
 
     datasets = {"base": run.data("base")}
     for variant in cfg.variants:
@@ -200,8 +257,12 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
                 f"--dataset.root={merged}",
             ),
             _complete(merged),
+            on_record=f"merge_{variant}" not in made,
         )
         datasets[variant] = merged
+    if not run.dry_run:
+        for variant in to_run:
+            run.record_size(variant, datasets[variant])
     return datasets
 
 
@@ -210,12 +271,12 @@ def train_dir(run: TableRun, variant: str, seed: int) -> Path:
     return run.out / "train" / variant / f"seed{seed}"
 
 
-def step_on_record(cfg: TableConfig, columns: dict, step: str) -> bool:
+def step_on_record(cfg: TableConfig, columns: dict, step: str, made_here: set[str] | None = None) -> bool:
     """Whether a step's output is on record in ``output_dir`` without being made again on this machine.
 
     A run's evaluation steps are, once its validation report is; its training is, once its whole
-    evaluation is, except the first seed's base policy, which generation needs as weights. Datasets
-    never are (the ledger does not hold them).
+    evaluation is, except the first seed's base policy while generation needs it as weights. A dataset
+    step is when it is not in ``made_here`` (:func:`steps_made_here`; None: every dataset is made again).
     """
     out = Path(cfg.output_dir)
     rehearsed = re.fullmatch(rf"{STEP_PREFIX}({'|'.join(PATHS)})_(.+?)_seed(\d+)", step)
@@ -224,12 +285,12 @@ def step_on_record(cfg: TableConfig, columns: dict, step: str) -> bool:
             out / REHEARSAL_FOLDER, rehearsed.group(2), int(rehearsed.group(3)), rehearsed.group(1)
         ).exists()
     parsed = re.fullmatch(r"(train|validate|test)_(.+?)_seed(\d+)(_.+)?", step)
-    if parsed is None:
-        return False
+    if parsed is None:  # a dataset: collected, generated or merged
+        return made_here is not None and step not in made_here
     kind, variant, seed = parsed.group(1), parsed.group(2), int(parsed.group(3))
     if kind != "train":
         return validation_report(out, variant, seed).exists()
-    needed_for_data = variant == "base" and seed == (cfg.train_seeds or [cfg.train.seed])[0]
+    needed_for_data = step == data_policy_step(cfg) and (made_here is None or step in made_here)
     return not needed_for_data and run_on_record(cfg, out, columns, variant, seed)
 
 
@@ -413,11 +474,6 @@ def summarise_row(
     return row
 
 
-def _dataset_size(root: Path) -> dict:
-    info = json.loads((root / "meta" / "info.json").read_text())
-    return {"episodes": info["total_episodes"], "frames": info["total_frames"]}
-
-
 def plan(cfg: TableConfig) -> list[dict]:
     """Every command the table runs, in order (step and command), running none: ``--dry_run=true``.
 
@@ -441,7 +497,14 @@ def run_table(cfg: TableConfig) -> dict:
     if cfg.ledger_dir:
         paper = cfg.paper_table()
         columns = dict(paper.columns) if paper is not None else {}
-        Ledger(Path(cfg.ledger_dir), Path(cfg.output_dir)).restore(lambda step: step_on_record(cfg, columns, step))
+        ledger = Ledger(Path(cfg.ledger_dir), Path(cfg.output_dir))
+        # the reports, the config and the dataset sizes first: they tell which rows still need their data
+        ledger.restore(lambda step: False)
+        derived = paper.derived if paper is not None else {}
+        sizes_file = Path(cfg.output_dir) / SIZES_FILE
+        sizes = json.loads(sizes_file.read_text()) if sizes_file.exists() else {}
+        made = steps_made_here(cfg, derived, rows_to_run(cfg, columns, sizes))
+        ledger.restore(lambda step: step_on_record(cfg, columns, step, made))
     check_resumed_config(cfg)
     run = TableRun(cfg)
     start = time.perf_counter()
@@ -461,7 +524,7 @@ def run_table(cfg: TableConfig) -> dict:
             variant,
             seeds,
             None if paper is None else paper.paper_success(variant, run.choose_on or None),
-            _dataset_size(datasets[variant]),
+            run.dataset_sizes[variant],
             label=variant_label(variant, run.derived),
             paper_columns={c: paper.paper_success(variant, c) for c in run.columns},
         )
