@@ -11,6 +11,7 @@ from importlib.util import find_spec
 from pathlib import Path
 
 import pytest
+from test_portable_math import REPORT_CODE_PATHS
 
 from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, portable_math_env
 from igen_lerobot.scripts import console
@@ -47,18 +48,10 @@ def test_the_installed_commands_are_the_declared_ones():
 
 
 # a script a console entry runs: reports the code paths and arguments it ran with
-PROBE = """
-import json, os, sys
-import torch
-from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK
-
+PROBE = REPORT_CODE_PATHS + """
 def main():
-    json.dump({
-        "env": {name: os.environ.get(name) for name in PORTABLE_MATH_ENV},
-        "rerun": os.environ.get(RERUN_MARK),
-        "argv": sys.argv[1:],
-        "torch": torch.backends.cpu.get_cpu_capability(),
-    }, open(sys.argv[1], "w"))
+    import sys
+    report_code_paths(sys.argv[1])
 """
 
 

@@ -73,18 +73,25 @@ def test_a_step_record_names_a_wider_host_run_as_avx2(monkeypatch):
     assert ", avx2, torch " in provenance.machine_identity()  # an AVX2 host's record is as before
 
 
+# what a process reports of the code paths it runs on and its arguments (test_console.py's probe too)
+REPORT_CODE_PATHS = """
+def report_code_paths(path):
+    import json, os, sys
+    import torch
+    from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK
+    json.dump({
+        "env": {name: os.environ.get(name) for name in PORTABLE_MATH_ENV},
+        "rerun": os.environ.get(RERUN_MARK),
+        "argv": sys.argv[1:],
+        "torch": torch.backends.cpu.get_cpu_capability(),
+    }, open(path, "w"))
+"""
 # a replay script: starts itself again on the portable paths, then reports what it runs on
-REPLAY_SCRIPT = """
-import json, os, sys
-from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, rerun_on_portable_paths
+REPLAY_SCRIPT = REPORT_CODE_PATHS + """
+import sys
+from igen_lerobot.core.portable_math import rerun_on_portable_paths
 rerun_on_portable_paths()
-import torch
-json.dump({
-    "env": {name: os.environ.get(name) for name in PORTABLE_MATH_ENV},
-    "rerun": os.environ.get(RERUN_MARK),
-    "argv": sys.argv[1:],
-    "torch": torch.backends.cpu.get_cpu_capability(),
-}, open(sys.argv[1], "w"))
+report_code_paths(sys.argv[1])
 """
 
 
