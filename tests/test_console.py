@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from test_portable_math import REPORT_CODE_PATHS
 
-from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, portable_math_env
+from igen_lerobot.core.portable_math import PORTABLE_MATH_ENV, RERUN_MARK, portable_math_env, started_as
 from igen_lerobot.scripts import console
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,11 +48,14 @@ def test_the_installed_commands_are_the_declared_ones():
 
 
 # a script a console entry runs: reports the code paths and arguments it ran with
-PROBE = REPORT_CODE_PATHS + """
+PROBE = (
+    REPORT_CODE_PATHS
+    + """
 def main():
     import sys
     report_code_paths(sys.argv[1])
 """
+)
 
 
 def _run_command(tmp_path: Path, **env: str) -> dict:
@@ -60,10 +63,12 @@ def _run_command(tmp_path: Path, **env: str) -> dict:
     done = tmp_path / "probe.json"
     clean = {k: v for k, v in os.environ.items() if k not in PORTABLE_MATH_ENV and k != RERUN_MARK}
     clean["PYTHONPATH"] = os.pathsep.join([str(tmp_path), *sys.path])
-    starter = "from igen_lerobot.scripts.console import start; start('igen_probe_script')"
+    # the command as its console script: a file of its name that calls its entry
+    command = tmp_path / "igen-probe-script"
+    command.write_text("from igen_lerobot.scripts.console import start\nstart('igen_probe_script')\n")
     # a loop of restarts would hang: the timeout fails the test instead
     subprocess.run(
-        [sys.executable, "-B", "-c", starter, str(done), "--n_trials", "5"],
+        [sys.executable, "-B", str(command), str(done), "--n_trials", "5"],
         env={**clean, **env},
         check=True,
         timeout=120,
@@ -97,20 +102,43 @@ def test_the_console_module_imports_nothing_heavy():
     assert console.start.__module__ == "igen_lerobot.scripts.console"
 
 
-# a table or a test that runs a command's entry point inside its own process (--in_process=true)
-IN_PROCESS = """
+# a table (--in_process=true) or a test that runs a command's entry point inside its own process
+IN_PROCESS = {
+    "table": """
 import sys
 from pathlib import Path
 from igen_lerobot.experiments.step_runner import _run_in_process
 print("started", flush=True)
 print("returned", _run_in_process(["igen-merge", "--help"], Path(sys.argv[1]), {}), flush=True)
-"""
+""",
+    "test": """
+import contextlib, os, sys
+from igen_lerobot.scripts import console
+print("started", flush=True)
+sys.argv = ["igen-merge", "--help"]
+try:
+    with open(os.environ["MERGE_LOG"], "w") as log, contextlib.redirect_stdout(log):
+        console.igen_merge()
+except SystemExit as done:
+    print("returned", done.code, flush=True)
+""",
+}
 
 
-def test_a_command_run_inside_another_process_does_not_start_that_process_again(tmp_path):
+def test_started_as_reads_a_console_script_or_a_module_run_not_a_caller():
+    assert started_as("igen-eval", ["/v/bin/python", "/v/bin/igen-eval", "--n_trials=5"])
+    assert started_as("igen-eval", ["python", "-B", "-X", "utf8", "-m", "igen_lerobot.scripts.igen_eval"])
+    assert not started_as("igen-eval", ["python", "-m", "pytest", "tests"])
+    assert not started_as("igen-eval", ["/v/bin/python", "/v/bin/igen-table", "--task=x"])
+    assert not started_as("igen-eval", ["python", "-c", "import sys;exec(eval(sys.stdin.readline()))"])
+
+
+@pytest.mark.parametrize("caller", sorted(IN_PROCESS))
+def test_a_command_run_inside_another_process_does_not_start_that_process_again(tmp_path, caller):
     clean = {k: v for k, v in os.environ.items() if k not in PORTABLE_MATH_ENV and k != RERUN_MARK}
+    clean["MERGE_LOG"] = str(tmp_path / "merge.log")
     done = subprocess.run(
-        [sys.executable, "-c", IN_PROCESS, str(tmp_path / "merge.log")],
+        [sys.executable, "-c", IN_PROCESS[caller], str(tmp_path / "merge.log")],
         env=clean,
         capture_output=True,
         text=True,

@@ -80,15 +80,43 @@ def pinned_paths(env: Mapping[str, str] | None = None) -> bool:
     return all(env.get(name) == value for name, value in PORTABLE_MATH_ENV.items())
 
 
-def rerun_on_portable_paths() -> None:
+def started_as(command: str, argv: list[str] | None = None) -> bool:
+    """Whether this process was started as ``command``: its console script, or ``python -m`` its module.
+
+    Not so when a test, or a table running its steps in-process, calls the command's entry point.
+    """
+    argv = list(sys.orig_argv if argv is None else argv)
+    module = command.replace("-", "_")
+    index = 1
+    while index < len(argv):
+        arg = argv[index]
+        if arg == "-m":
+            return index + 1 < len(argv) and argv[index + 1].rsplit(".", 1)[-1] == module
+        if arg in ("-X", "-W"):  # interpreter options that take a value
+            index += 2
+            continue
+        if arg.startswith("-"):
+            if arg == "-c":
+                return False
+            index += 1
+            continue
+        return Path(arg).name in (command, module, f"{module}.py")
+    return False
+
+
+def rerun_on_portable_paths(command: str | None = None) -> None:
     """Start this script again (same interpreter, flags and arguments) with the portable settings.
 
     For scripts that replay a table's steps (its trials, its rehearsals): they must compute what the
     step computed. Returns at once where the settings are in place already, where the host has none,
     or in the process started again (a setting the user chose wins there, as in :func:`subprocess_env`).
+    With ``command``, only a process started as that command starts again (:func:`started_as`): an
+    entry point called inside another program leaves that program alone.
     Call it before the work starts: what the process did before is done again.
     """
     if not portable_math_env() or pinned_paths(os.environ) or os.environ.get(RERUN_MARK):
+        return
+    if command is not None and not started_as(command):
         return
     logging.getLogger(__name__).info("starting again on the tables' code paths (%s)", " ".join(PORTABLE_MATH_ENV))
     sys.stdout.flush()

@@ -35,7 +35,7 @@ def run_cli(config_class: type, command: Callable[..., object], prog: str) -> No
     """
     from igen_lerobot.core.portable_math import rerun_on_portable_paths
 
-    rerun_on_portable_paths()  # started as `python -m igen_lerobot.scripts...`: the console commands did already
+    rerun_on_portable_paths(command=prog)  # `python -m igen_lerobot.scripts.<prog>`: the console commands did already
     from lerobot.utils.utils import init_logging
 
     from igen_lerobot.core.plugins import discover_plugins

@@ -15,8 +15,12 @@ from igen_lerobot.core.portable_math import rerun_on_portable_paths
 
 
 def start(script_module: str) -> None:
-    """Start again on the portable paths (once), then run ``script_module``'s ``main``."""
-    rerun_on_portable_paths()
+    """Start again on the portable paths (once), then run ``script_module``'s ``main``.
+
+    Only a process started as the command (``igen_eval`` -> ``igen-eval``) starts again; a test that
+    calls the entry point runs it in its own process, as it is.
+    """
+    rerun_on_portable_paths(command=script_module.rsplit(".", 1)[-1].replace("_", "-"))
     import_module(script_module).main()
 
 
