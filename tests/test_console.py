@@ -30,11 +30,14 @@ def _declared_commands() -> dict[str, str]:
 def test_every_igen_command_goes_through_a_console_entry_that_starts_a_real_script(monkeypatch):
     commands = _declared_commands()
     assert {"igen-eval", "igen-generate", "igen-collect", "igen-table", "igen-deploy"} <= set(commands)
+    # every entry module imported before any is patched: one imported while another's ``start`` is
+    # patched would bind the patch as its own, and keep it after the test
+    modules = {target: import_module(target.split(":")[0]) for target in commands.values()}
     for name, target in commands.items():
         module_name, function_name = target.split(":")
         assert module_name.endswith(".console"), f"{name} = {target}: not started on the portable paths"
         started = []
-        entry_module = import_module(module_name)
+        entry_module = modules[target]
         monkeypatch.setattr(entry_module, "start", started.append)
         getattr(entry_module, function_name)()
         assert len(started) == 1 and find_spec(started[0]) is not None, (name, started)
