@@ -24,8 +24,7 @@ import logging
 import os
 import platform
 import sys
-from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Mapping
 from pathlib import Path
 
 # the AVX2 generation of each library's kernels (Haswell: OpenBLAS's name for AVX2 + FMA)
@@ -122,25 +121,6 @@ def rerun_on_portable_paths(command: str | None = None) -> None:
     sys.stdout.flush()
     sys.stderr.flush()
     os.execve(sys.executable, list(sys.orig_argv), subprocess_env({RERUN_MARK: "1"}))
-
-
-@contextmanager
-def staying_in_this_process() -> Iterator[None]:
-    """Call an igen command's entry point inside this process: it must not start the process again.
-
-    Without it the command's restart (:func:`rerun_on_portable_paths`) would replace the caller, a
-    test session or a table running its steps in-process, with a fresh start of the caller's own
-    command line. The command then runs on this process's paths, as anything in it does.
-    """
-    saved = os.environ.get(RERUN_MARK)
-    os.environ[RERUN_MARK] = "1"
-    try:
-        yield
-    finally:
-        if saved is None:
-            os.environ.pop(RERUN_MARK, None)
-        else:
-            os.environ[RERUN_MARK] = saved
 
 
 def main() -> None:

@@ -22,7 +22,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 
 from igen_lerobot.core.exceptions import IgenError
-from igen_lerobot.core.portable_math import staying_in_this_process, subprocess_env
+from igen_lerobot.core.portable_math import subprocess_env
 from igen_lerobot.experiments.ledger import DATA_FILE, REUSED_FILE, Ledger
 from igen_lerobot.experiments.provenance import code_version, keep_assembly_record
 from igen_lerobot.experiments.training_reuse import dataset_digest, link_training, records_of_training
@@ -304,7 +304,7 @@ def _run_in_process(command: list[str], log: Path, env: dict[str, str]) -> int:
         threads = torch.get_num_threads()
         torch.set_num_threads(int(env["OMP_NUM_THREADS"]))
     try:
-        with open(log, "a") as sink, contextlib.redirect_stdout(sink), staying_in_this_process():
+        with open(log, "a") as sink, contextlib.redirect_stdout(sink):
             main()
         return 0
     except SystemExit as error:
