@@ -18,10 +18,16 @@ def test_a_table_on_a_new_machine_restores_its_ledger_and_makes_only_what_unfini
     assert first.returncode == 0, first.stderr[-4000:]
     report = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
 
-    # the ledger holds the evaluation reports, the step records, the config and the datasets' sizes:
-    # no dataset, no checkpoint
+    # the ledger holds the evaluation reports, the step records, the config, the datasets' sizes and
+    # the weights that generation ran: no dataset, no other checkpoint
     kept = {p.relative_to(ledger).as_posix() for p in ledger.rglob("*") if p.is_file()}
     assert {"table_config.json", "dataset_sizes.json", *STEP_RECORDS[:3]} <= kept
+    policy = out / "train" / "base" / "seed7" / "checkpoints" / "000002" / "pretrained_model"
+    assert {f"data_policy/{p.name}" for p in policy.iterdir()} | {"data_policy/manifest.json"} == {
+        k for k in kept if k.startswith("data_policy/")
+    }
+    assert "data_policy/model.safetensors" in kept
+    first_data = json.loads((ledger / "step_data.json").read_text())
     for row in report["rows"]:
         for seed in (7, 8):
             assert f"eval/{row['variant']}/seed{seed}/validation.json" in kept
@@ -49,19 +55,25 @@ def test_a_table_on_a_new_machine_restores_its_ledger_and_makes_only_what_unfini
         assert times[step] != recorded[step], step
 
     # lost again, and Source Int seed 8's evaluation never reached the ledger: that row's data are made
-    # again, with the base policy that collects them; what is on record is not
+    # again, by the base policy the ledger kept (not trained again), so they are the data the row's
+    # other seeds trained on; what is on record is not made again
     shutil.rmtree(out)
     shutil.rmtree(ledger / "eval" / "source_int" / "seed8")
     third = tiny_table(out, results, *flags)
     assert third.returncode == 0, third.stderr[-4000:]
     logs = {p.name for p in (out / "logs").glob("*.log")}
-    made = {"train_base_seed7", "source_int", "merge_source_int", "train_source_int_seed8", "validate_source_int_seed8"}
+    made = {"source_int", "merge_source_int", "train_source_int_seed8", "validate_source_int_seed8"}
     assert {f"{step}.log" for step in made} <= logs
-    assert not logs & {f"{step}.log" for step in ("train_base_seed8", "validate_base_seed7", "train_source_int_seed7")}
+    not_made = ("train_base_seed7", "train_base_seed8", "validate_base_seed7", "train_source_int_seed7")
+    assert not logs & {f"{step}.log" for step in not_made}
+    assert (policy / "model.safetensors").read_bytes() == (ledger / "data_policy" / "model.safetensors").read_bytes()
+    data = json.loads((out / "step_data.json").read_text())
+    assert data["train_source_int_seed8"] == first_data["train_source_int_seed8"]
     times = json.loads((out / "step_times.json").read_text())
     for step in made:
         assert times[step] != recorded[step], step  # this making's time, not the lost one's plus it
-    assert times["validate_source_int_seed7"] == recorded["validate_source_int_seed7"]
+    for step in ("train_base_seed7", "validate_source_int_seed7"):
+        assert times[step] == recorded[step], step
     assert json.loads((ledger / "step_times.json").read_text()) == times
     resumed = json.loads((tmp_path / "results" / "block_grasp.json").read_text())
 
@@ -110,6 +122,35 @@ def test_the_ledger_keeps_only_small_records_and_never_overwrites_a_local_one(tm
     assert json.loads((out / "eval" / "igen" / "seed1" / "validation.json").read_text()) == {"local": True}
     assert restored == []
     assert Ledger(None, out).restore(on_record=lambda step: True) == []
+
+
+def test_the_kept_data_policy_is_restored_whole_or_not_at_all(tmp_path):
+    out, folder = tmp_path / "out", tmp_path / "ledger"
+    weights = tmp_path / "trained" / "pretrained_model"
+    weights.mkdir(parents=True)
+    (weights / "config.json").write_text('{"type": "bc_rnn"}')
+    (weights / "model.safetensors").write_bytes(bytes(range(256)) * 4)
+    ledger = Ledger(folder, out)
+    ledger.keep_policy(weights, "train_base_seed7")
+    target = out / "train" / "base" / "seed7" / "checkpoints" / "000002" / "pretrained_model"
+
+    assert not ledger.restore_policy(target, "train_base_seed8")  # another run's weights
+    assert Ledger(None, out).restore_policy(target, "train_base_seed7") is False
+    kept = folder / "data_policy" / "model.safetensors"
+    whole = kept.read_bytes()
+    kept.write_bytes(whole[:-1] + b"\x00")  # a flipped byte
+    assert not ledger.restore_policy(target, "train_base_seed7") and not target.exists()
+    kept.write_bytes(whole)
+    (folder / "data_policy" / "manifest.json").unlink()  # cut short before its manifest
+    assert not ledger.restore_policy(target, "train_base_seed7") and not target.exists()
+
+    ledger.keep_policy(weights, "train_base_seed7")
+    assert ledger.restore_policy(target, "train_base_seed7")
+    assert sorted(p.name for p in target.iterdir()) == ["config.json", "model.safetensors"]
+    assert (target / "model.safetensors").read_bytes() == whole
+    # the ordinary restore leaves the weights to restore_policy
+    ledger.restore(on_record=lambda step: True)
+    assert not (out / "data_policy").exists()
 
 
 def test_a_rehearsing_table_keeps_each_runs_rehearsal_and_trains_again_only_the_unrehearsed(tmp_path, tiny_table):

@@ -218,6 +218,23 @@ def steps_made_here(cfg: TableConfig, derived: dict, to_run: list[str]) -> set[s
     return {*(step.name for step in (*BASE_STEPS, *parts)), *merges, *policy}
 
 
+def restore_data_policy(cfg: TableConfig, columns: dict, ledger: Ledger, made: set[str]) -> bool:
+    """Put the ledger's data policy in place where data still to make need it; whether it was.
+
+    Only a policy whose own run is evaluated on record: an unevaluated one is trained again, as its
+    validation reads every checkpoint, and the ledger keeps only the last.
+    """
+    step = data_policy_step(cfg)
+    seed = (cfg.train_seeds or [cfg.train.seed])[0]
+    out = Path(cfg.output_dir)
+    final = final_checkpoint(train_dir(out, "base", seed), cfg.train.steps)
+    if step not in made or cfg.retrain_restored or (final / "config.json").exists():
+        return False
+    if not run_on_record(cfg, out, columns, "base", seed):
+        return False
+    return ledger.restore_policy(final, step)
+
+
 def build_datasets(run: TableRun) -> dict[str, Path]:
     """Collect, generate and merge what the rows still to run need; returns every row's training dataset.
 
@@ -266,9 +283,9 @@ def build_datasets(run: TableRun) -> dict[str, Path]:
     return datasets
 
 
-def train_dir(run: TableRun, variant: str, seed: int) -> Path:
-    """One training run's ``--output_dir``: ``train/<variant>/seed<k>``."""
-    return run.out / "train" / variant / f"seed{seed}"
+def train_dir(table_dir: Path, variant: str, seed: int) -> Path:
+    """One training run's ``--output_dir``: ``train/<variant>/seed<k>`` of the table's output folder."""
+    return Path(table_dir) / "train" / variant / f"seed{seed}"
 
 
 def step_on_record(cfg: TableConfig, columns: dict, step: str, made_here: set[str] | None = None) -> bool:
@@ -312,7 +329,7 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     """
     normaliser = observation_stats_args(run.cfg.observation_stats, run.data("base"), dataset)
     cfg = replace(run.cfg.train, seed=seed, extra_args=[*run.cfg.train.extra_args, *normaliser])
-    out = train_dir(run, variant, seed)
+    out = train_dir(run.out, variant, seed)
     final = final_checkpoint(out, cfg.steps)
     done = final / "config.json"
     command = train_command(cfg, dataset, f"local/{dataset.name}", out)
@@ -334,6 +351,8 @@ def train(run: TableRun, variant: str, dataset: Path, seed: int, weights_needed:
     if not run.dry_run and (final / "config.json").exists() and not (out / KEY_FILE).exists():
         # marked for a sibling table that would train the same (also a training finished before keys were)
         write_key(out, key or training_key(command, env, dataset, out), source)
+    if weights_needed and not run.dry_run and (final / "config.json").exists():
+        run.ledger.keep_policy(final, name)  # a new machine makes the table's data with these weights
     if not run.dry_run and name not in run.data_digests and read_as_it_is(dataset, out):
         run.record_data(name, dataset)  # a training finished before data were recorded
         run.write_step_records()
@@ -385,7 +404,7 @@ def evaluate_seed(run: TableRun, variant: str, seed: int) -> dict:
     trials, all from ``--test_seed`` (the same scenes in each column: only the column's flags differ).
     """
     cfg = run.cfg
-    trained = train_dir(run, variant, seed)
+    trained = train_dir(run.out, variant, seed)
     validation = _eval(
         run,
         f"validate_{variant}_seed{seed}",
@@ -504,6 +523,8 @@ def run_table(cfg: TableConfig) -> dict:
         sizes_file = Path(cfg.output_dir) / SIZES_FILE
         sizes = json.loads(sizes_file.read_text()) if sizes_file.exists() else {}
         made = steps_made_here(cfg, derived, rows_to_run(cfg, columns, sizes))
+        if restore_data_policy(cfg, columns, ledger, made):
+            made.discard(data_policy_step(cfg))  # its training is on record with the weights
         ledger.restore(lambda step: step_on_record(cfg, columns, step, made))
     check_resumed_config(cfg)
     run = TableRun(cfg)
