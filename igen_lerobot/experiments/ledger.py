@@ -7,7 +7,7 @@ is kept in version control (``docs/results/ledger/<table>``), and a run on a new
 them first: every training seed whose evaluation is on record is not trained again, and only the
 datasets the rows still to run need are made again.
 
-One set of weights is kept too: the base policy that generation runs (a few MB). Trainings differ
+One set of weights is kept too: the base policy that generation runs (BC-RNN's: about 8 MB). Trainings differ
 across hosts (docs/results/reproducibility.md), so a policy trained again on a new machine would make
 other source interventions, and the rows made there would rest on other data than the rows before;
 the kept weights make every row's data with the policy the table began with, and spare the training.

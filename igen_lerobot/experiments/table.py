@@ -201,9 +201,14 @@ def rows_to_run(cfg: TableConfig, columns: dict, sizes: dict) -> list[str]:
     ]
 
 
+def data_policy_seed(cfg: TableConfig) -> int:
+    """The training seed of the base policy that generation runs: the first."""
+    return (cfg.train_seeds or [cfg.train.seed])[0]
+
+
 def data_policy_step(cfg: TableConfig) -> str:
-    """The training step of the base policy that generation runs: the first seed's."""
-    return f"train_base_seed{(cfg.train_seeds or [cfg.train.seed])[0]}"
+    """The training step of the base policy that generation runs."""
+    return f"train_base_seed{data_policy_seed(cfg)}"
 
 
 def steps_made_here(cfg: TableConfig, derived: dict, to_run: list[str]) -> set[str]:
@@ -224,9 +229,7 @@ def restore_data_policy(cfg: TableConfig, columns: dict, ledger: Ledger, made: s
     Only a policy whose own run is evaluated on record: an unevaluated one is trained again, as its
     validation reads every checkpoint, and the ledger keeps only the last.
     """
-    step = data_policy_step(cfg)
-    seed = (cfg.train_seeds or [cfg.train.seed])[0]
-    out = Path(cfg.output_dir)
+    step, seed, out = data_policy_step(cfg), data_policy_seed(cfg), Path(cfg.output_dir)
     final = final_checkpoint(train_dir(out, "base", seed), cfg.train.steps)
     if step not in made or cfg.retrain_restored or (final / "config.json").exists():
         return False
