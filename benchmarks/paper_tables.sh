@@ -43,8 +43,9 @@
 # A machine can be lost between sessions with its outputs: every table keeps its evaluation reports,
 # step times and commits in docs/results/ledger/<name> (version-controlled) as each step finishes, and
 # on a new machine restores them and trains no seed whose numbers are on record (and, in a rehearsed
-# table, whose rehearsal is); only D, the datasets of the rows still to run and, where one of those
-# runs it, the base policy are made again. A
+# table, whose rehearsal is); only D and the datasets of the rows still to run are made again, these
+# with the base policy's weights the ledger keeps (data_policy/: a policy trained again on another
+# host would generate other data), which is trained again only when it is not yet evaluated. A
 # table already published in docs/results/<name>.json is not made again unless REDO names it
 # (REDO=all: every table).
 #
