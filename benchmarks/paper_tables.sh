@@ -80,14 +80,15 @@ declare -A TABLES=(
   [nut_and_peg]="--task=nut_and_peg ${long[*]}"
   [block_grasp_randomized]="--task=block_grasp --randomize=${RANDOMIZE} --variants=${SIM_TO_REAL_ROWS} --train.steps=6000 --train.save_freq=1000 --train.threads=1 --rehearse=true --run_first=[igen]"
 )
-# Nut-and-Peg before Coffee: its issue needs this one table, 2-Piece/Coffee's three more, so the lane
-# that finishes the randomised table takes it while the other finishes 2-Piece
+# Nut-and-Peg is left out of the default order until its generation can finish a geometry-2 episode:
+# its base policy does not place the nut after a regrasp of the real handle, so its I-Gen step keeps
+# only geometry-1 episodes, at 4% of its attempts (docs/benchmarks.md). Named, it still runs.
 ORDER=(block_grasp nut_insertion nut_insertion_contact_position block_grasp_randomized
-  two_piece_assembly nut_and_peg coffee two_piece_assembly_direction two_piece_assembly_scaling)
+  two_piece_assembly coffee two_piece_assembly_direction two_piece_assembly_scaling)
 names=("$@")
 [ ${#names[@]} -gt 0 ] || names=("${ORDER[@]}")
 for name in "${names[@]}"; do
-  [ -n "${TABLES[$name]+set}" ] || { echo "unknown table '$name'; one of: ${ORDER[*]}"; exit 2; }
+  [ -n "${TABLES[$name]+set}" ] || { echo "unknown table '$name'; one of: ${!TABLES[*]}"; exit 2; }
 done
 mkdir -p "$root"
 locks=$root/.locks
