@@ -145,6 +145,7 @@ def test_the_kept_data_policy_is_restored_whole_or_not_at_all(tmp_path):
     assert not ledger.restore_policy(target, "train_base_seed7") and not target.exists()
 
     ledger.keep_policy(weights, "train_base_seed7")
+    (folder / "data_policy" / ".model.safetensors.partial").write_bytes(b"a copy cut short")  # left by a lost machine
     assert ledger.restore_policy(target, "train_base_seed7")
     assert sorted(p.name for p in target.iterdir()) == ["config.json", "model.safetensors"]
     assert (target / "model.safetensors").read_bytes() == whole

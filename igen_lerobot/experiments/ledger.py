@@ -126,7 +126,7 @@ class Ledger:
         partial.parent.mkdir(parents=True, exist_ok=True)
         if partial.exists():
             shutil.rmtree(partial)
-        shutil.copytree(kept, partial, ignore=shutil.ignore_patterns(POLICY_MANIFEST))
+        shutil.copytree(kept, partial, ignore=shutil.ignore_patterns(POLICY_MANIFEST, ".*"))
         os.replace(partial, pretrained)
         logger.info("restored the data policy of %s from the ledger into %s", step, pretrained)
         return True
