@@ -12,7 +12,7 @@ A base policy that cannot finish the place subtask after a recovery makes no Int
 
     .venv/bin/python benchmarks/nut_and_peg_ends.py --policy PRETRAINED_MODEL --geometry 1 --trials 10
     .venv/bin/python benchmarks/nut_and_peg_ends.py --policy PRETRAINED_MODEL --geometry 2 --trials 12 \
-        --mode igen --source outputs/tables/nut_and_peg/data/source_int
+        --mode igen --source outputs/tables/nut_and_peg/data/source_int [--place_may_err]
 """
 
 from __future__ import annotations
@@ -69,6 +69,13 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=777, help="trial seeds: episode_seed(seed, i)")
     parser.add_argument("--mode", choices=("policy", "igen"), default="policy")
     parser.add_argument("--source", type=Path, help="--mode=igen: the source interventions (a LeRobot dataset)")
+    parser.add_argument(
+        "--place_may_err",
+        action="store_true",
+        help="--mode=igen, a design probe: the place subtask may take a recovery too (after IntervenGen's "
+        "mistake budget of policy steps without placing, a source place is replayed), where the task says "
+        "nothing there can go wrong",
+    )
     args = parser.parse_args()
     rerun_on_portable_paths()  # the table's code paths
     register_third_party_plugins()
@@ -105,6 +112,10 @@ def main() -> None:
             max_steps=cfg.episode_length + IntervenGenConfig().mistake_budget,
             policy=PolicySourceConfig(path=str(args.policy)),
         )
+        if args.place_may_err:
+            from lerobot_env_igen.nut_and_peg.env import NutAndPegEnv
+
+            NutAndPegEnv.mistake_possible = lambda self, subtask: True
         runner = AttemptRunner(job)
         after_recovery: list[dict] = []
         replay = intervengen.replay_segment
@@ -122,7 +133,8 @@ def main() -> None:
             ends[attempt.reason or "kept"] += 1
             row = {"attempt": i, "end": attempt.reason or "kept", "steps": attempt.steps}
             print(json.dumps({**row, "recoveries": list(after_recovery), **nut_end(runner.env)}), flush=True)
-    print(json.dumps({"policy": str(args.policy), "geometry": args.geometry, "mode": args.mode, **ends}))
+    summary = {"policy": str(args.policy), "geometry": args.geometry, "mode": args.mode}
+    print(json.dumps({**summary, "place_may_err": args.place_may_err, **ends}))
 
 
 if __name__ == "__main__":
