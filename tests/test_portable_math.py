@@ -87,12 +87,15 @@ def report_code_paths(path):
     }, open(path, "w"))
 """
 # a replay script: starts itself again on the portable paths, then reports what it runs on
-REPLAY_SCRIPT = REPORT_CODE_PATHS + """
+REPLAY_SCRIPT = (
+    REPORT_CODE_PATHS
+    + """
 import sys
 from igen_lerobot.core.portable_math import rerun_on_portable_paths
 rerun_on_portable_paths()
 report_code_paths(sys.argv[1])
 """
+)
 
 
 def _replay(tmp_path: Path, **env: str) -> dict:
