@@ -59,6 +59,10 @@ def test_a_table_on_a_new_machine_restores_its_ledger_and_makes_only_what_unfini
     # other seeds trained on; what is on record is not made again
     shutil.rmtree(out)
     shutil.rmtree(ledger / "eval" / "source_int" / "seed8")
+    # asked for another budget, it refuses before any weights are put in place
+    changed = tiny_table(out, results, *flags, "--train.steps=3")
+    assert changed.returncode != 0 and "other settings" in changed.stderr, changed.stderr[-2000:]
+    assert not (out / "train").exists()
     third = tiny_table(out, results, *flags)
     assert third.returncode == 0, third.stderr[-4000:]
     logs = {p.name for p in (out / "logs").glob("*.log")}

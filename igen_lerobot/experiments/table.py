@@ -514,22 +514,32 @@ def plan(cfg: TableConfig) -> list[dict]:
     return run.commands
 
 
+def restore_from_ledger(cfg: TableConfig) -> None:
+    """Bring a table's records (and, where data still to make need it, its data policy) from its ledger.
+
+    The reports, the config and the dataset sizes come first: the config is checked before anything
+    is put in place (a changed budget would file the kept weights under another step), and the sizes
+    tell which rows still need their data.
+    """
+    paper = cfg.paper_table()
+    columns = dict(paper.columns) if paper is not None else {}
+    ledger = Ledger(Path(cfg.ledger_dir), Path(cfg.output_dir))
+    ledger.restore(lambda step: False)
+    check_resumed_config(cfg)
+    sizes_file = Path(cfg.output_dir) / SIZES_FILE
+    sizes = json.loads(sizes_file.read_text()) if sizes_file.exists() else {}
+    made = steps_made_here(cfg, paper.derived if paper is not None else {}, rows_to_run(cfg, columns, sizes))
+    if restore_data_policy(cfg, columns, ledger, made):
+        made.discard(data_policy_step(cfg))  # its training is on record with the weights
+    ledger.restore(lambda step: step_on_record(cfg, columns, step, made))
+
+
 def run_table(cfg: TableConfig) -> dict:
     """Build, train and evaluate every variant; write the table's JSON and re-render the results page."""
     if cfg.ledger_dir:
-        paper = cfg.paper_table()
-        columns = dict(paper.columns) if paper is not None else {}
-        ledger = Ledger(Path(cfg.ledger_dir), Path(cfg.output_dir))
-        # the reports, the config and the dataset sizes first: they tell which rows still need their data
-        ledger.restore(lambda step: False)
-        derived = paper.derived if paper is not None else {}
-        sizes_file = Path(cfg.output_dir) / SIZES_FILE
-        sizes = json.loads(sizes_file.read_text()) if sizes_file.exists() else {}
-        made = steps_made_here(cfg, derived, rows_to_run(cfg, columns, sizes))
-        if restore_data_policy(cfg, columns, ledger, made):
-            made.discard(data_policy_step(cfg))  # its training is on record with the weights
-        ledger.restore(lambda step: step_on_record(cfg, columns, step, made))
-    check_resumed_config(cfg)
+        restore_from_ledger(cfg)
+    else:
+        check_resumed_config(cfg)
     run = TableRun(cfg)
     start = time.perf_counter()
     env = cfg.env_config()
