@@ -2,8 +2,12 @@
 
 ``--mode=policy``: the policy alone, as ``igen-eval`` runs a trial (seeded per trial), and the first
 step at which the nut was held by both pads, lifted off the table, on the peg, and the fingers closed
-on air (a missed grasp). ``--mode=igen``: generation attempts as ``igen-generate --mode=igen`` makes
-them (``--source`` holds the interventions), and after each replayed recovery whether the nut is held.
+on air (a missed grasp); the steps at which the place stalled (the task's place mistake signal), and
+the stillest second of the held nut in the air off the peg (its least net displacement over the
+stall window, and how far from the peg's axis): what the stall's thresholds were chosen on, a place
+that succeeds against one that freezes. ``--mode=igen``: generation attempts as ``igen-generate
+--mode=igen`` makes them (``--source`` holds the interventions), and after each replayed recovery its
+subtask, whether the nut is held and for how many of its steps an arm joint was at the end of its range.
 Each line ends with where the nut is at the end: its distance from the peg's axis in the table plane
 and its height, in mm, and whether it is still held.
 
@@ -12,7 +16,7 @@ A base policy that cannot finish the place subtask after a recovery makes no Int
 
     .venv/bin/python benchmarks/nut_and_peg_ends.py --policy PRETRAINED_MODEL --geometry 1 --trials 10
     .venv/bin/python benchmarks/nut_and_peg_ends.py --policy PRETRAINED_MODEL --geometry 2 --trials 12 \
-        --mode igen --source outputs/tables/nut_and_peg/data/source_int [--place_may_err]
+        --mode igen --source outputs/tables/nut_and_peg/data/source_int [--place_budget]
 """
 
 from __future__ import annotations
@@ -36,21 +40,29 @@ def nut_end(env) -> dict:
 
 
 def policy_trial(env, policy, seed: int, max_steps: int) -> dict:
-    """One trial as igen-eval runs it, with the first step of each milestone."""
+    """One trial as igen-eval runs it, with the first step of each milestone and the place's stalls."""
     from igen_lerobot.core.agents import seed_policy
+    from lerobot_env_igen.nut_and_peg.env import STALL_STEPS
 
     obs = env.reset(seed)
     policy.reset()
     seed_policy(policy, seed)
     first: dict[str, int] = {}
+    stalls: list[int] = []
+    held_in_air: list[np.ndarray | None] = []  # the nut's position while held and lifted off the peg
     success, step = False, max_steps
     for step in range(1, max_steps + 1):
+        subtask = env.subtask_index()
         info = env.step(policy.act(obs))
+        if info.mistake and subtask == 1:
+            stalls.append(step)
+        in_air = env.nut_held() and env.nut_lifted() and not env.nut_on_peg()
+        held_in_air.append(env.true_object_poses()["nut"][:3, 3] if in_air else None)
         for name, now in (
             ("held", env.nut_held()),
             ("lifted", env.nut_lifted()),
             ("on_peg", env.nut_on_peg()),
-            ("closed_on_air", info.mistake),
+            ("closed_on_air", info.mistake and subtask == 0),
         ):
             if now and name not in first:
                 first[name] = step
@@ -58,7 +70,25 @@ def policy_trial(env, policy, seed: int, max_steps: int) -> dict:
             success = True
             break
         obs = env.observe()
-    return {"success": success, "steps": step, "first": first, **nut_end(env)}
+    stillest = stillest_second(held_in_air, STALL_STEPS, env.true_object_poses()["peg"][:2, 3])
+    return {"success": success, "steps": step, "first": first, "stalls": stalls, "stillest": stillest, **nut_end(env)}
+
+
+def stillest_second(track: list[np.ndarray | None], window: int, peg_xy: np.ndarray) -> dict | None:
+    """The least net displacement [mm] of the held nut over ``window`` steps in the air, and where it was."""
+    best = None
+    for end in range(window, len(track)):
+        span = track[end - window : end + 1]
+        if any(p is None for p in span):
+            continue
+        moved = float(np.linalg.norm(span[-1] - span[0]))
+        if best is None or moved < best[0]:
+            best = (moved, end, span[-1])
+    if best is None:
+        return None
+    moved, end, where = best
+    off_axis = float(np.linalg.norm(where[:2] - peg_xy))
+    return {"moved_mm": round(1000 * moved, 1), "step": end + 1, "off_axis_mm": round(1000 * off_axis)}
 
 
 def main() -> None:
@@ -70,11 +100,11 @@ def main() -> None:
     parser.add_argument("--mode", choices=("policy", "igen"), default="policy")
     parser.add_argument("--source", type=Path, help="--mode=igen: the source interventions (a LeRobot dataset)")
     parser.add_argument(
-        "--place_may_err",
+        "--place_budget",
         action="store_true",
-        help="--mode=igen, a design probe: the place subtask may take a recovery too (after IntervenGen's "
-        "mistake budget of policy steps without placing, a source place is replayed), where the task says "
-        "nothing there can go wrong",
+        help="--mode=igen, a design probe: IntervenGen's mistake budget forces a place recovery too (after "
+        "that many policy steps without placing, a source place is replayed), where the task leaves the place "
+        "to its stall signal",
     )
     args = parser.parse_args()
     rerun_on_portable_paths()  # the table's code paths
@@ -112,18 +142,34 @@ def main() -> None:
             max_steps=cfg.episode_length + IntervenGenConfig().mistake_budget,
             policy=PolicySourceConfig(path=str(args.policy)),
         )
-        if args.place_may_err:
-            from lerobot_env_igen.nut_and_peg.env import NutAndPegEnv
+        from lerobot_env_igen.nut_and_peg.env import NutAndPegEnv
 
-            NutAndPegEnv.mistake_possible = lambda self, subtask: True
+        if args.place_budget:
+            NutAndPegEnv.budget_forces_recovery = lambda self, subtask: True
         runner = AttemptRunner(job)
         after_recovery: list[dict] = []
         replay = intervengen.replay_segment
 
-        def traced_replay(env, *replay_args, flagged: bool, **kwargs):
-            outcome = replay(env, *replay_args, flagged=flagged, **kwargs)
+        at_limit = [0]  # steps of the replay with an arm joint within 1 deg of its range's end
+        step_to = NutAndPegEnv.step_to
+
+        def traced_step(env, *step_args, **kwargs):
+            info = step_to(env, *step_args, **kwargs)
+            joints = [int(np.flatnonzero(env.model.jnt_qposadr == adr)[0]) for adr in env.arm.arm_qpos]
+            q, limits = env.data.qpos[env.arm.arm_qpos], env.model.jnt_range[joints]
+            at_limit[0] += bool(np.min(np.minimum(q - limits[:, 0], limits[:, 1] - q)) < np.radians(1.0))
+            return info
+
+        def traced_replay(env, recorder, obs, segment, *replay_args, flagged: bool, **kwargs):
+            at_limit[0] = 0
+            NutAndPegEnv.step_to = traced_step
+            try:
+                outcome = replay(env, recorder, obs, segment, *replay_args, flagged=flagged, **kwargs)
+            finally:
+                NutAndPegEnv.step_to = step_to
             if flagged:
-                after_recovery.append({"held": env.nut_held(), "steps": outcome.steps})
+                row = {"subtask": segment.subtask, "held": env.nut_held(), "steps": outcome.steps}
+                after_recovery.append({**row, "joint_at_limit_steps": at_limit[0]})
             return outcome
 
         intervengen.replay_segment = traced_replay
@@ -134,7 +180,7 @@ def main() -> None:
             row = {"attempt": i, "end": attempt.reason or "kept", "steps": attempt.steps}
             print(json.dumps({**row, "recoveries": list(after_recovery), **nut_end(runner.env)}), flush=True)
     summary = {"policy": str(args.policy), "geometry": args.geometry, "mode": args.mode}
-    print(json.dumps({**summary, "place_may_err": args.place_may_err, **ends}))
+    print(json.dumps({**summary, "place_budget": args.place_budget, **ends}))
 
 
 if __name__ == "__main__":

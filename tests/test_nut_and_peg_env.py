@@ -195,3 +195,39 @@ def test_the_base_policy_places_a_nut_the_operator_regrasped_on_geometry_2():
             break
     assert handed_back is not None and info.success and env.corruption[0] == 1.0
     env.close()
+
+
+def test_a_held_nut_standing_still_off_the_peg_is_the_place_mistake():
+    """The place's mistake signal on real physics: the operator grasps and lifts the nut, the hand stops
+    (a frozen policy): the signal fires once the nut has stood still ``STALL_STEPS`` steps, once per
+    window; stopped over the peg's axis (a place aligning) it never fires; the operator then finishes."""
+    from lerobot_env_igen.nut_and_peg.env import STALL_OFF_AXIS, STALL_STEPS
+
+    config = _config("1")
+    env, operator = config.make_task_env(), config.make_scripted_operator()
+    env.reset(episode_seed(5, 0))
+    operator.reset(env)
+
+    def run_operator_until(done) -> None:
+        for _ in range(config.episode_length):
+            info = env.step(operator.act(env))
+            assert not info.mistake  # a place that moves never stalls
+            if done():
+                return
+        raise AssertionError("the operator never got there")
+
+    def hold_still(steps: int) -> list[int]:
+        eef = env.eef_pose()[:3, 3].copy()
+        return [k for k in range(1, steps + 1) if env.step_to(eef, True).mistake]
+
+    run_operator_until(lambda: env.nut_held() and env.nut_lifted())
+    assert env.nut_off_axis() > 10 * STALL_OFF_AXIS  # lifted where it lay, far from the peg
+    fired = hold_still(2 * STALL_STEPS + 12)
+    assert len(fired) == 2 and STALL_STEPS <= fired[0] <= STALL_STEPS + 10  # after a second of standing still
+    assert fired[1] - fired[0] == STALL_STEPS + 1  # the next stall needs a full window of its own
+    assert env.nut_held() and not env.is_success()
+    run_operator_until(lambda: env.nut_off_axis() < 0.005)  # carried over the peg, still in the air
+    assert env.nut_lifted() and not env.nut_on_peg()
+    assert hold_still(2 * STALL_STEPS + 12) == []  # aligned over the peg: not a stall
+    run_operator_until(env.is_success)
+    env.close()

@@ -123,3 +123,68 @@ def test_the_recording_shows_the_missed_grasp_and_the_regrasp(data, tmp_path):
     assert subtask_change.startswith("subtask 0 -> 1 (place)")  # the regrasp
     assert hand_back.startswith("hand-back") and HELD_WIDTH[0] <= mm[2] <= HELD_WIDTH[1]  # holding the nut
     assert end == "end: success"
+
+
+class _FreezesWithTheNutInTheAir:
+    """The scripted base policy, except that once it holds the nut lifted off the table it stops there.
+
+    What the table's learned policy does after a regrasp on geometry 2 (``benchmarks/nut_and_peg_ends.py``):
+    it holds the nut still in the air off the peg to the end of the episode.
+    """
+
+    def __init__(self, config) -> None:
+        self.inner, self.actions = config.make_scripted_policy(), config.make_action_space()
+
+    def reset(self) -> None:
+        self.inner.reset()
+
+    def act(self, observation):
+        from igen_lerobot.core.task import OBS_ENV_STATE, OBS_STATE
+        from lerobot_env_igen.nut_and_peg.spec import HELD_WIDTH
+        from lerobot_env_igen.square_nut import NUT_HALF_THICKNESS, TABLE_TOP_Z
+
+        state, nut = observation[OBS_STATE], observation[OBS_ENV_STATE]
+        holding = HELD_WIDTH[0] <= state[7] <= HELD_WIDTH[1]
+        if holding and nut[2] > TABLE_TOP_Z + NUT_HALF_THICKNESS + 0.03:  # the observed nut's centre is exact
+            here = pos_quat_to_pose(state[:3], state[3:7])
+            return self.actions.action_towards(here, here, True)
+        return self.inner.act(observation)
+
+
+def test_a_place_that_stalls_is_recovered_and_the_episode_kept():
+    """IntervenGen on geometry 2 with a policy that freezes holding the nut: the grasp's missed grasp and
+    the place's stall each take a flagged source recovery; between them the policy's unflagged place
+    frames; the place recovery finishes the task. Without the place's signal the attempt fails."""
+    from igen_lerobot.collection.record import record_intervention
+    from igen_lerobot.core.seeding import episode_seed
+    from igen_lerobot.generation.intervengen import IntervenGenConfig, generate_intervention
+    from igen_lerobot.generation.sources import parse_interventions
+    from lerobot_env_igen.nut_and_peg.config import NutAndPegEnvConfig
+    from lerobot_env_igen.nut_and_peg.env import STALL_STEPS, NutAndPegEnv
+
+    config = NutAndPegEnvConfig(geometry="2")
+    env, actions = config.make_task_env(), config.make_action_space()
+    scripted, operator = config.make_scripted_policy(), config.make_scripted_operator()
+    sources = [
+        record_intervention(env, scripted, operator, episode_seed(7, i), config.episode_length) for i in range(2)
+    ]
+    library = parse_interventions(sources, config.task_spec, actions.target_pose, actions.gripper_closed)
+    policy, cfg = _FreezesWithTheNutInTheAir(config), IntervenGenConfig()
+    max_steps = config.episode_length + cfg.mistake_budget
+    attempt = generate_intervention(env, policy, library, cfg, 3, max_steps)
+    assert attempt.kept, attempt.reason
+    ep = attempt.episode
+    assert ep.kind == EpisodeKind.IGEN and ep.success and len(attempt.details["recoveries"]) == 2
+    (grasp_rec, _, grasp_end), (policy_run, _, stall), (place_rec, _, end) = _runs(ep.is_intervention)
+    assert grasp_rec and not policy_run and place_rec and end == ep.length
+    assert (ep.subtask[:grasp_end] == 0).any() and (ep.subtask[grasp_end:] == 1).all()  # the place from the regrasp on
+    assert (ep.source[grasp_end:stall] == FrameSource.POLICY).all() and stall - grasp_end > STALL_STEPS
+    assert not (ep.source[stall:] == FrameSource.POLICY).any()  # the source's place to the end
+    # the signal off, the same attempt never recovers the place: the budget leaves the place to the policy
+    original = NutAndPegEnv._place_stalled
+    NutAndPegEnv._place_stalled = lambda self: False
+    try:
+        assert generate_intervention(env, policy, library, cfg, 3, max_steps).reason == "failed"
+    finally:
+        NutAndPegEnv._place_stalled = original
+    env.close()

@@ -260,13 +260,14 @@ class TaskEnv(abc.ABC):
         """
         return None
 
-    def mistake_possible(self, subtask: int) -> bool:
-        """Whether the task's mistake signal can fire in ``subtask``.
+    def budget_forces_recovery(self, subtask: int) -> bool:
+        """Whether running out IntervenGen's mistake budget in ``subtask`` counts as a mistake.
 
-        IntervenGen forces a recovery on a policy that ran its mistake budget without a detected
-        mistake only where one could have been detected; elsewhere (Nut-and-Peg's place subtask:
-        nothing there is misperceived) the policy runs on to success, the next subtask or the
-        attempt's step limit. Default: every subtask.
+        A policy that ran the budget without a signalled mistake is then given a recovery.
+        Default: every subtask. A task whose policy may need longer than the budget to do a subtask
+        right says no there and signals that subtask's mistakes itself (Nut-and-Peg's place: a place
+        that succeeds holds the nut longer than the budget; a stalled one is a signalled mistake);
+        the policy then runs on to a mistake, success, the next subtask or the attempt's step limit.
         """
         return True
 

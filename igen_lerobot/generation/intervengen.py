@@ -2,8 +2,9 @@
 
 In the scene and pose error of ``seed`` the policy acts on its corrupted observation until it
 makes a mistake, detected by the task's own mistake signal (``StepInfo.mistake``: the contact
-that reveals the error, or for Nut-and-Peg a grasp that closes on air), or until a step budget
-runs out (only in a subtask where the task can signal a mistake: ``TaskEnv.mistake_possible``).
+that reveals the error, or for Nut-and-Peg a grasp that closes on air and a place that stalls),
+or until a step budget runs out (only in a subtask where the task says so:
+``TaskEnv.budget_forces_recovery``).
 A source recovery for that subtask is moved to the object's true pose, bridged to by
 interpolation and replayed open loop. Control returns to the policy afterwards, once the task
 says so (``TaskEnv.recovery_done``), so a subtask may see zero, one or several mistake/recovery
@@ -134,14 +135,14 @@ def generate_intervention(
             if policy is None:  # ablation after its replayed mistake: another recovery, no policy
                 why = "budget"
             else:
-                # the budget forces a recovery only where the task could have signalled a mistake
-                can_err = env.mistake_possible(subtask)
-                budget = min(cfg.mistake_budget, max_steps - steps) if can_err else max_steps - steps
+                # the budget forces a recovery only where the task says running it out is a mistake
+                forced = env.budget_forces_recovery(subtask)
+                budget = min(cfg.mistake_budget, max_steps - steps) if forced else max_steps - steps
                 obs, why, n = _run_policy_until_mistake(env, policy, recorder, obs, budget)
                 steps += n
                 success = why == "success"
-                if why == "budget" and not can_err:
-                    break  # out of time in a subtask with nothing to recover from
+                if why == "budget" and not forced:
+                    break  # out of time in a subtask with no signalled mistake to recover from
         if success or why == "subtask_done":
             continue
         if len(recoveries) >= cfg.max_recoveries:

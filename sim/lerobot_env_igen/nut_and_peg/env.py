@@ -10,7 +10,13 @@ nothing reveals it. 6-DOF delta-pose actions at 20 Hz, 400 steps.
   the pads' centres at the handle's mid-height. At the same point on the wrong side there is no
   handle: the fingers close fully, on air, 1.8 cm beyond the ring's outer edge (the cue; see
   ``benchmarks/nut_and_peg_closed_width.py``).
-* Mistake signal: the fingers coming to rest closed on air (``EMPTY_WIDTH``) on this step.
+* Mistake signals: in the grasp, the fingers coming to rest closed on air (``EMPTY_WIDTH``) on this
+  step; in the place, the held nut standing still in the air off the peg (it moved less than
+  ``STALL_MOVE`` over the last ``STALL_STEPS`` steps, all of them held, lifted and more than
+  ``STALL_OFF_AXIS`` from the peg's axis), what an operator watching a frozen arm reacts to.
+  Measured with the table's base policy (``benchmarks/nut_and_peg_ends.py``): after a regrasp on
+  geometry 2 it freezes 51-83 mm off the axis; a place that succeeds slows down to align only over
+  the peg, within 16 mm of its axis.
 * Subtask progress: 0 while the nut lies on the table, 1 once both finger pads hold it and while it
   is held, in the air or on the peg (dropped back on the table: 0, to be grasped again), 2 on success.
 * Success: robosuite's ``on_peg`` **and released** (no finger touches the nut).
@@ -18,14 +24,16 @@ nothing reveals it. 6-DOF delta-pose actions at 20 Hz, 400 steps.
   (the parallel gripper's symmetry, which the scripted rule uses to keep its yaw in (-pi/2, pi/2]):
   a grasp segment starts the way nearer the hand (not a half turn of the wrist beside the nut), a
   place segment keeps the held nut on the side of the hand it was on in the source.
-  A mistake can happen only in the grasp subtask (the peg's pose is exact); a replayed
-  grasp recovery hands control back once both pads have held the nut for ``HAND_BACK_HELD_STEPS``
+  IntervenGen's step budget forces a recovery only in the grasp: a place that succeeds holds the nut
+  140-245 steps, longer than the budget, so a policy that moves keeps the place until it stalls. A
+  replayed grasp recovery hands control back once both pads have held the nut for ``HAND_BACK_HELD_STEPS``
   consecutive steps, a settled grasp the policy recognises by the opening (at the first touch the
   fingers are still closing, and the policy, believing the handle elsewhere, would open them).
 """
 
 from __future__ import annotations
 
+from collections import deque
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -47,6 +55,9 @@ SETTLE_STEPS = 2  # control periods the dropped-in nut gets to come to rest at r
 HAND_BACK_HELD_STEPS = 3  # a grasp recovery hands back once both pads held the nut this many steps in a row
 GRASP = 0  # the grasp subtask's index
 HALF_TURN = rot_z(np.pi)  # about the hand's approach axis (its z axis, pointing down)
+STALL_STEPS = 20  # control periods (1 s) the held nut must stand still off the peg to count as a stall
+STALL_MOVE = 0.005  # [m] its net displacement over them under which it stands still
+STALL_OFF_AXIS = 0.02  # [m] farther than this from the peg's axis it cannot go down the peg
 
 
 class NutAndPegEnv(PandaTaskEnv):
@@ -57,6 +68,7 @@ class NutAndPegEnv(PandaTaskEnv):
         self.nut_region = config.region()
         self._closed_on_air = False
         self._held_steps = 0  # consecutive steps with the nut between both pads
+        self._stall_track: deque[np.ndarray] = deque(maxlen=STALL_STEPS + 1)  # the held nut off the peg
 
     def place(self, rng: np.random.Generator) -> None:
         xy = self.nut_region.sample(rng)
@@ -66,6 +78,7 @@ class NutAndPegEnv(PandaTaskEnv):
         self.set_fixed_pose("peg", (PEG_XY[0], PEG_XY[1], PEG_CENTER_Z))
         self._closed_on_air = False
         self._held_steps = 0
+        self._stall_track.clear()
 
     def settle(self) -> None:
         home = self.arm.eef_pos()
@@ -88,11 +101,29 @@ class NutAndPegEnv(PandaTaskEnv):
         return self.nut_on_peg() and self.released()
 
     def mistake(self, revealed_now: bool, close_gripper: bool) -> bool:
-        """The fingers came to rest closed on air on this step (nothing between them: a missed grasp)."""
+        """A missed grasp (the fingers came to rest closed on air on this step) or a stalled place."""
         empty = close_gripper and self.gripper_width() < EMPTY_WIDTH
         fired = empty and not self._closed_on_air
         self._closed_on_air = empty
-        return fired
+        return self._place_stalled() or fired
+
+    def nut_off_axis(self) -> float:
+        """The nut's distance [m] from the peg's axis in the table plane."""
+        nut, peg = self.data.xpos[self.bodies["nut"]], self.data.xpos[self.bodies["peg"]]
+        return float(np.linalg.norm(nut[:2] - peg[:2]))
+
+    def _place_stalled(self) -> bool:
+        """The held nut has stood still in the air off the peg for ``STALL_STEPS`` steps (once per stall)."""
+        if not (self.nut_held() and self.nut_lifted() and self.nut_off_axis() > STALL_OFF_AXIS):
+            self._stall_track.clear()
+            return False
+        self._stall_track.append(self.data.xpos[self.bodies["nut"]].copy())
+        if len(self._stall_track) <= STALL_STEPS:
+            return False
+        if np.linalg.norm(self._stall_track[-1] - self._stall_track[0]) >= STALL_MOVE:
+            return False
+        self._stall_track.clear()  # fired: another stall needs a full window of its own
+        return True
 
     def nut_lifted(self) -> bool:
         """The nut is off the table: in the air or resting on the peg (not where the grasp starts again)."""
@@ -109,8 +140,8 @@ class NutAndPegEnv(PandaTaskEnv):
         self._held_steps = self._held_steps + 1 if self.nut_held() else 0
         return info
 
-    def mistake_possible(self, subtask: int) -> bool:
-        """Only the grasp can go wrong: the handle's side is the error; the peg's pose is exact."""
+    def budget_forces_recovery(self, subtask: int) -> bool:
+        """Only in the grasp: a place that succeeds takes longer than the budget; a stalled one is signalled."""
         return subtask == GRASP
 
     def recovery_done(self, subtask: int) -> bool:
