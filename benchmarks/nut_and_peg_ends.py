@@ -7,7 +7,7 @@ the stillest second of the held nut in the air off the peg (its least net displa
 stall window, and how far from the peg's axis): what the stall's thresholds were chosen on, a place
 that succeeds against one that freezes. ``--mode=igen``: generation attempts as ``igen-generate
 --mode=igen`` makes them (``--source`` holds the interventions), and after each replayed recovery its
-subtask, whether the nut is held and for how many of its steps an arm joint was at the end of its range.
+subtask, whether the nut is held and for how many of its steps each arm joint was at the end of its range.
 Each line ends with where the nut is at the end: its distance from the peg's axis in the table plane
 and its height, in mm, and whether it is still held.
 
@@ -150,18 +150,19 @@ def main() -> None:
         after_recovery: list[dict] = []
         replay = intervengen.replay_segment
 
-        at_limit = [0]  # steps of the replay with an arm joint within 1 deg of its range's end
+        at_limit: Counter = Counter()  # per arm joint (1-7): steps of the replay within 1 deg of its range's end
         step_to = NutAndPegEnv.step_to
 
         def traced_step(env, *step_args, **kwargs):
             info = step_to(env, *step_args, **kwargs)
             joints = [int(np.flatnonzero(env.model.jnt_qposadr == adr)[0]) for adr in env.arm.arm_qpos]
             q, limits = env.data.qpos[env.arm.arm_qpos], env.model.jnt_range[joints]
-            at_limit[0] += bool(np.min(np.minimum(q - limits[:, 0], limits[:, 1] - q)) < np.radians(1.0))
+            margin = np.minimum(q - limits[:, 0], limits[:, 1] - q)
+            at_limit.update(int(j) + 1 for j in np.flatnonzero(margin < np.radians(1.0)))
             return info
 
         def traced_replay(env, recorder, obs, segment, *replay_args, flagged: bool, **kwargs):
-            at_limit[0] = 0
+            at_limit.clear()
             NutAndPegEnv.step_to = traced_step
             try:
                 outcome = replay(env, recorder, obs, segment, *replay_args, flagged=flagged, **kwargs)
@@ -169,7 +170,7 @@ def main() -> None:
                 NutAndPegEnv.step_to = step_to
             if flagged:
                 row = {"subtask": segment.subtask, "held": env.nut_held(), "steps": outcome.steps}
-                after_recovery.append({**row, "joint_at_limit_steps": at_limit[0]})
+                after_recovery.append({**row, "joint_at_limit_steps": dict(sorted(at_limit.items()))})
             return outcome
 
         intervengen.replay_segment = traced_replay
