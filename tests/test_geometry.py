@@ -160,3 +160,15 @@ def test_matrices_off_orthonormal_get_scipys_projection(seed):
             assert np.array_equal(pose_to_pos_quat(pose)[1], Rotation.from_matrix(noisy).as_quat()), scale
     with pytest.raises(ValueError, match="determinant"):
         rotvec_from_matrix(np.diag([1.0, 1.0, -1.0]))
+
+
+def test_headings_and_wrapped_angles():
+    from igen_lerobot.core.geometry import heading, rot_z, wrap_angle
+
+    angles = np.array([-3.0, -0.5, 0.0, 1.2, 3.1])
+    np.testing.assert_allclose(heading(np.stack([rot_z(a) for a in angles])), angles, atol=1e-12)
+    np.testing.assert_allclose(
+        wrap_angle(np.array([np.pi, -np.pi, 3 * np.pi / 2, -7.0, 0.25])),
+        [-np.pi, -np.pi, -np.pi / 2, -7.0 + 2 * np.pi, 0.25],
+        atol=1e-12,
+    )

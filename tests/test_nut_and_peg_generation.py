@@ -14,6 +14,7 @@ from test_nut_insertion_cli import ok, run_here
 
 from igen_lerobot.core.episode import EpisodeKind
 from igen_lerobot.core.geometry import pos_quat_to_pose
+from igen_lerobot.core.seeding import episode_seed
 from igen_lerobot.core.task import FrameSource
 from igen_lerobot.datasets.reader import dataset_spec, load_episodes
 
@@ -156,7 +157,6 @@ def test_a_place_that_stalls_is_recovered_and_the_episode_kept():
     the place's stall each take a flagged source recovery; between them the policy's unflagged place
     frames; the place recovery finishes the task. Without the place's signal the attempt fails."""
     from igen_lerobot.collection.record import record_intervention
-    from igen_lerobot.core.seeding import episode_seed
     from igen_lerobot.generation.intervengen import IntervenGenConfig, generate_intervention
     from igen_lerobot.generation.sources import parse_interventions
     from lerobot_env_igen.nut_and_peg.config import NutAndPegEnvConfig
@@ -187,4 +187,109 @@ def test_a_place_that_stalls_is_recovered_and_the_episode_kept():
         assert generate_intervention(env, policy, library, cfg, 3, max_steps).reason == "failed"
     finally:
         NutAndPegEnv._place_stalled = original
+    env.close()
+
+
+def _stall_beside_the_peg(env, operator, seed: int, wrist: float) -> None:
+    """The scripted operator grasps and lifts the nut; the hand then carries it to 6 cm from the peg's axis at
+    the peg's top and turns about its axis until the wrist is at ``wrist`` [rad]: a frozen policy's pose."""
+    from igen_lerobot.core.geometry import rot_z
+    from lerobot_env_igen.nut_and_peg.spec import PEG_XY
+
+    env.reset(episode_seed(31, seed))
+    operator.reset(env)
+    for _ in range(400):
+        env.step(operator.act(env))
+        if env.nut_held() and env.nut_lifted():
+            break
+    beside = np.array([PEG_XY[0] - 0.06, PEG_XY[1], 0.94])
+    for _ in range(120):
+        nut, eef = env.true_object_poses()["nut"][:3, 3], env.eef_pose()[:3, 3]
+        env.step_to(eef + np.clip(beside - nut, -0.01, 0.01), True)
+    for _ in range(200):
+        turn = wrist - env.wrist_joint()[0]
+        if abs(turn) < 0.02:
+            break
+        T = env.eef_pose()  # the wrist turns opposite to the hand's heading (the hand points down)
+        env.step_to(T[:3, 3], True, goal_rot=rot_z(-np.clip(turn, -0.1, 0.1)) @ T[:3, :3])
+    assert env.nut_held() and env.nut_lifted() and abs(env.wrist_joint()[0] - wrist) < 0.05, env.wrist_joint()
+
+
+def test_a_place_replayed_from_a_stall_lifts_first_and_keeps_the_wrist_in_range():
+    """A source place replayed from a frozen policy's pose (nut held beside the peg at its top, wrist 2.4 rad,
+    near the end of its +-2.90 rad range): the bridge lifts the nut clear of the peg's top before moving it over,
+    the nut follows the source nut's path up to a quarter turn, the wrist stays 10 deg inside its range and
+    the place succeeds. With the hand's half turn chosen as for a place started on the table, the wrist
+    reaches its limit in the same scene."""
+    from igen_lerobot.collection.record import record_intervention
+    from igen_lerobot.core.geometry import pose_inv, transform_segment
+    from igen_lerobot.core.recorder import EpisodeRecorder
+    from igen_lerobot.generation.replay import ReplayConfig, replay_segment
+    from igen_lerobot.generation.sources import SegmentRole, parse_interventions
+    from lerobot_env_igen.nut_and_peg.config import NutAndPegEnvConfig
+    from lerobot_env_igen.nut_and_peg.env import HALF_TURN, PEG_CLEARANCE, NutAndPegEnv
+    from lerobot_env_igen.square_nut import NUT_HALF_THICKNESS, PEG_TOP_Z
+
+    sources_config = NutAndPegEnvConfig(geometry="2")
+    env, actions = sources_config.make_task_env(), sources_config.make_action_space()
+    policy, operator = sources_config.make_scripted_policy(), sources_config.make_scripted_operator()
+    sources = [record_intervention(env, policy, operator, episode_seed(7, i), 400) for i in range(2)]
+    places = parse_interventions(sources, sources_config.task_spec, actions.target_pose, actions.gripper_closed)
+    places = places.require(SegmentRole.RECOVERY, 1)
+    config = NutAndPegEnvConfig(geometry="1")
+    env, operator = config.make_task_env(), config.make_scripted_operator()
+
+    def replay_from_a_stall(seed: int) -> tuple[bool, float, np.ndarray]:
+        _stall_beside_the_peg(env, operator, seed, wrist=2.4)
+        segment = places[seed % len(places)]
+        nut, margins = [], []
+        step_to = NutAndPegEnv.step_to
+
+        def traced(self, *args, **kwargs):
+            info = step_to(self, *args, **kwargs)
+            angle, low, high = self.wrist_joint()
+            margins.append(min(angle - low, high - angle))
+            nut.append(self.true_object_poses()["nut"][:3, 3])
+            return info
+
+        NutAndPegEnv.step_to = traced
+        try:
+            rng = np.random.default_rng(0)
+            outcome = replay_segment(env, EpisodeRecorder(env), env.observe(), segment, ReplayConfig(), rng, True, 300)
+        finally:
+            NutAndPegEnv.step_to = step_to
+        return bool(outcome.info.success), min(margins), np.array(nut)
+
+    for seed in range(4):
+        _stall_beside_the_peg(env, operator, seed, wrist=2.4)
+        segment = places[seed % len(places)]
+        # the goals carry this grasp along the source nut's path: its centre exactly, its heading up to quarter turns
+        T_nut_eef = pose_inv(env.true_object_poses()["nut"]) @ env.eef_pose()
+        goals = transform_segment(segment.targets, segment.T_world_obj, env.true_object_poses()["peg"])
+        replayed = env.replay_goals(goals, 1, segment.T_world_objects, segment.eef[0])
+        source_nut = goals @ pose_inv(pose_inv(segment.T_world_objects["nut"]) @ segment.eef[0])
+        np.testing.assert_allclose((replayed @ pose_inv(T_nut_eef))[:, :3, 3], source_nut[:, :3, 3], atol=1e-9)
+        waypoint = env.bridge_waypoint(1)
+        bottom = env.true_object_poses()["nut"][2, 3] - NUT_HALF_THICKNESS
+        np.testing.assert_allclose(waypoint[:3, 3], env.eef_pose()[:3, 3] + [0, 0, PEG_TOP_Z + PEG_CLEARANCE - bottom])
+        assert env.bridge_waypoint(0) is None
+        start = env.true_object_poses()["nut"][:2, 3]
+        success, margin, nut = replay_from_a_stall(seed)
+        assert success and margin > np.radians(10), (seed, np.degrees(margin))
+        over = np.flatnonzero(np.linalg.norm(nut[:, :2] - start, axis=1) > 0.01)[0]  # first 1 cm sideways
+        assert nut[over, 2] - NUT_HALF_THICKNESS > PEG_TOP_Z  # lifted clear of the peg's top before moving over
+
+    def half_turn_rule(self, goals, T_src_world_nut, T_src_world_eef):
+        R_nut_eef_now = self.true_object_poses()["nut"][:3, :3].T @ self.eef_pose()[:3, :3]
+        R_nut_eef_src = T_src_world_nut[:3, :3].T @ T_src_world_eef[:3, :3]
+        turned = goals.copy()
+        turned[:, :3, :3] = goals[:, :3, :3] @ HALF_TURN
+        return turned if np.trace(R_nut_eef_now.T @ R_nut_eef_src) < 1.0 else goals  # more than a quarter turn apart
+
+    rule = NutAndPegEnv._stalled_place_goals
+    NutAndPegEnv._stalled_place_goals = half_turn_rule
+    try:
+        assert replay_from_a_stall(3)[1] < np.radians(1)
+    finally:
+        NutAndPegEnv._stalled_place_goals = rule
     env.close()

@@ -32,11 +32,13 @@ __all__ = [
     "quat_xyzw_to_wxyz",
     "rotation_angle",
     "transform_segment",
+    "heading",
     "interpolate_poses",
     "quat_xyzw_from_matrix",
     "rotvec_from_matrix",
     "matrix_from_rotvec",
     "rot_z",
+    "wrap_angle",
     "pose_vector",
 ]
 
@@ -218,6 +220,16 @@ def matrix_from_rotvec(rotvec: np.ndarray) -> np.ndarray:
         return Rotation.from_rotvec(rotvec).as_matrix()
     quat = _compiled_rotations.from_rotvec(rotvec, degrees=False)
     return _compiled_rotations.as_matrix(quat[None])[0]
+
+
+def wrap_angle(angle: np.ndarray | float) -> np.ndarray | float:
+    """Angles [rad] wrapped into [-pi, pi)."""
+    return (np.asarray(angle) + np.pi) % (2 * np.pi) - np.pi
+
+
+def heading(rot: np.ndarray) -> np.ndarray | float:
+    """The heading [rad] of rotations' x axes in the xy plane (``rot`` (3, 3) or (..., 3, 3))."""
+    return np.arctan2(rot[..., 1, 0], rot[..., 0, 0])
 
 
 def rot_z(angle: float) -> np.ndarray:

@@ -297,6 +297,15 @@ class TaskEnv(abc.ABC):
         """
         return goals
 
+    def bridge_waypoint(self, subtask: int) -> np.ndarray | None:
+        """A pose (4, 4) the bridge to a replayed segment of ``subtask`` passes through first, or None.
+
+        Default None: the bridge goes straight from the hand to the segment's first goal. A task whose
+        hand may hold an object low beside an obstacle says where to go first (Nut-and-Peg: a place
+        replayed with the nut stalled beside the peg lifts it clear of the peg's top before moving over).
+        """
+        return None
+
     def action_towards(self, T_world_eef_target: np.ndarray, gripper_closed: bool) -> np.ndarray:
         """The action that drives the end effector towards a target pose in one step."""
         return self.action_space.action_towards(self.eef_pose(), T_world_eef_target, gripper_closed)

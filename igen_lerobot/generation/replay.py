@@ -2,8 +2,9 @@
 
 MimicGen's recipe: transform the segment's end-effector goals so they keep their relation to
 the object (``T_new_eef = T_new_obj · inv(T_src_obj) · T_src_eef``), bridge from where the
-robot is to the first transformed goal with a linear/slerp interpolation, then execute the
-goals one per control step with the recorded gripper commands.
+robot is to the first transformed goal with a linear/slerp interpolation (through a waypoint where
+the task asks for one: ``TaskEnv.bridge_waypoint``), then execute the goals one per control step with
+the recorded gripper commands.
 
 The bridge holds the gripper command the segment settles on over its first frames, not its first
 frame's alone: a recorded policy can issue a one-frame command at a hidden-state reset (BC-RNN at
@@ -95,6 +96,13 @@ class ReplayOutcome:
     interpolation: np.ndarray  # (K, 4, 4) the bridge goals
 
 
+def _bridge_leg(T_from: np.ndarray, T_to: np.ndarray, cfg: ReplayConfig) -> np.ndarray:
+    """Interpolated goals from one pose to another, long enough for the distance and the turn."""
+    distance = float(np.linalg.norm(T_to[:3, 3] - T_from[:3, 3]))
+    angle = rotation_angle(T_from[:3, :3], T_to[:3, :3])
+    return interpolate_poses(T_from, T_to, cfg.bridge_steps(distance, angle))
+
+
 def replay_segment(
     env: TaskEnv,
     recorder: EpisodeRecorder,
@@ -117,9 +125,9 @@ def replay_segment(
     transformed = transform_segment(segment.targets, segment.T_world_obj, T_world_obj)
     transformed = env.replay_goals(transformed, segment.subtask, segment.T_world_objects, segment.eef[0])
     T_world_eef = env.eef_pose()
-    distance = float(np.linalg.norm(transformed[0][:3, 3] - T_world_eef[:3, 3]))
-    angle = rotation_angle(T_world_eef[:3, :3], transformed[0][:3, :3])
-    bridge = interpolate_poses(T_world_eef, transformed[0], cfg.bridge_steps(distance, angle))
+    waypoint = env.bridge_waypoint(segment.subtask)
+    legs = [T_world_eef, transformed[0]] if waypoint is None else [T_world_eef, waypoint, transformed[0]]
+    bridge = np.concatenate([_bridge_leg(a, b, cfg) for a, b in zip(legs[:-1], legs[1:], strict=True)])
     hold = np.repeat(transformed[-1:], cfg.hold_steps, axis=0)
     goals = np.concatenate([bridge, transformed, hold])
     gripper = np.concatenate(

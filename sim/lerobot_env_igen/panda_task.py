@@ -265,6 +265,13 @@ class PandaTaskEnv(TaskEnv):
     def eef_pose(self) -> np.ndarray:
         return self.arm.eef_pose()
 
+    def wrist_joint(self) -> tuple[float, float, float]:
+        """The last arm joint's (the wrist's turn about the hand's axis) angle and range [rad]."""
+        address = self.arm.arm_qpos[-1]
+        joint = int(np.flatnonzero(self.model.jnt_qposadr == address)[0])
+        low, high = self.model.jnt_range[joint]
+        return float(self.data.qpos[address]), float(low), float(high)
+
     def gripper_width(self) -> float:
         return self.arm.gripper_width()
 

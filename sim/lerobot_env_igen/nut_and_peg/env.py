@@ -23,7 +23,10 @@ nothing reveals it. 6-DOF delta-pose actions at 20 Hz, 400 steps.
 * Generation: a replayed segment's hand goals may be turned half a turn about the approach axis
   (the parallel gripper's symmetry, which the scripted rule uses to keep its yaw in (-pi/2, pi/2]):
   a grasp segment starts the way nearer the hand (not a half turn of the wrist beside the nut), a
-  place segment keeps the held nut on the side of the hand it was on in the source.
+  place segment keeps the held nut on the side of the hand it was on in the source. A place replayed
+  after a stall (the nut already in the air) instead carries this grasp along the source nut's path,
+  under the quarter turn of the square nut that keeps the wrist inside its range, and its bridge lifts
+  the nut clear of the peg's top first.
   IntervenGen's step budget forces a recovery only in the grasp: a place that succeeds holds the nut
   140-245 steps, longer than the budget, so a policy that moves keeps the place until it stalls. A
   replayed grasp recovery hands control back once both pads have held the nut for ``HAND_BACK_HELD_STEPS``
@@ -38,13 +41,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from igen_lerobot.core.geometry import rot_z, rotation_angle
+from igen_lerobot.core.geometry import heading, make_pose, pose_inv, rot_z, rotation_angle, wrap_angle
 from igen_lerobot.core.task import StepInfo
 from lerobot_env_igen.nut_and_peg.spec import EMPTY_WIDTH, NUT_REGION_CENTER, PEG_XY
 from lerobot_env_igen.panda import TOP_DOWN_ROT
 from lerobot_env_igen.panda_spec import GRIPPER, TABLE_TOP_Z
 from lerobot_env_igen.panda_task import PandaTaskEnv
-from lerobot_env_igen.square_nut import NUT_HALF_THICKNESS, PEG_CENTER_Z, on_peg, square_nut, square_peg
+from lerobot_env_igen.square_nut import NUT_HALF_THICKNESS, PEG_CENTER_Z, PEG_TOP_Z, on_peg, square_nut, square_peg
 
 if TYPE_CHECKING:
     from lerobot_env_igen.nut_and_peg.config import NutAndPegEnvConfig
@@ -58,6 +61,7 @@ HALF_TURN = rot_z(np.pi)  # about the hand's approach axis (its z axis, pointing
 STALL_STEPS = 20  # control periods (1 s) the held nut must stand still off the peg to count as a stall
 STALL_MOVE = 0.005  # [m] its net displacement over them under which it stands still
 STALL_OFF_AXIS = 0.02  # [m] farther than this from the peg's axis it cannot go down the peg
+PEG_CLEARANCE = 0.03  # [m] the held nut's bottom above the peg's top before a replayed place moves it over
 
 
 class NutAndPegEnv(PandaTaskEnv):
@@ -157,12 +161,16 @@ class NutAndPegEnv(PandaTaskEnv):
         T_src_world_objects: dict[str, np.ndarray],
         T_src_world_eef: np.ndarray,
     ) -> np.ndarray:
-        """The goals, or the same goals with the hand half a turn about its approach axis.
+        """The goals, or equivalent goals for this hand's grasp.
 
-        Grasp (the hand empty at the start): whichever starts nearer the hand's orientation. Place
-        (the nut held): whichever holds the nut on the source's side of the hand, so it arrives
-        where the source's did.
+        Grasp (the hand empty at the start): the goals or the same goals with the hand half a turn
+        about its approach axis, whichever starts nearer the hand's orientation. Place with the nut
+        taken on the table: whichever of those holds the nut on the source's side of the hand, so it
+        arrives where the source's did. Place with the nut already in the air (a stalled place): see
+        :meth:`_stalled_place_goals`.
         """
+        if subtask != GRASP and self.nut_held() and self.nut_lifted():
+            return self._stalled_place_goals(goals, T_src_world_objects["nut"], T_src_world_eef)
         turned = goals.copy()
         turned[:, :3, :3] = goals[:, :3, :3] @ HALF_TURN
         R_world_eef = self.eef_pose()[:3, :3]
@@ -173,3 +181,42 @@ class NutAndPegEnv(PandaTaskEnv):
             R_nut_eef_src = T_src_world_objects["nut"][:3, :3].T @ T_src_world_eef[:3, :3]
             turn = rotation_angle(R_nut_eef_now, R_nut_eef_src) > np.pi / 2
         return turned if turn else goals
+
+    def _stalled_place_goals(self, goals: np.ndarray, T_src_world_nut: np.ndarray, T_src_world_eef: np.ndarray):
+        """The source nut's path carried with this grasp, the nut's quarter turn keeping the wrist in range.
+
+        Of the nut's quarter turns about its axis, the one that keeps the wrist farthest inside its range:
+        the square nut fits the square peg under any quarter turn about its axis. A policy that stalled has
+        left the wrist wherever it did; the half turn of the hand that keeps the nut on the source's side drove
+        the wrist (joint 7) to its limit in 15 of 33 failed replays (``benchmarks/nut_and_peg_ends.py``). The
+        wrist turns opposite to the hand's heading (the hand points down) and takes the short way to each goal.
+        """
+        T_world_eef = self.eef_pose()
+        T_nut_eef = pose_inv(self.true_object_poses()["nut"]) @ T_world_eef
+        T_src_eef_nut = pose_inv(pose_inv(T_src_world_nut) @ T_src_world_eef)
+        wrist, low, high = self.wrist_joint()
+        best_margin, best = -np.inf, goals
+        for quarter in range(4):
+            candidate = goals @ T_src_eef_nut @ make_pose(np.zeros(3), rot_z(quarter * np.pi / 2)) @ T_nut_eef
+            headings = np.concatenate([[heading(T_world_eef[:3, :3])], heading(candidate[:, :3, :3])])
+            path = wrist - np.cumsum(wrap_angle(np.diff(headings)))
+            margin = float(min(np.min(path - low), np.min(high - path)))
+            if margin > best_margin:
+                best_margin, best = margin, candidate
+        return best
+
+    def bridge_waypoint(self, subtask: int) -> np.ndarray | None:
+        """Straight up from the hand until the held nut's bottom clears the peg's top by ``PEG_CLEARANCE``.
+
+        For a place replayed with the nut in the air (a stalled place: the policy freezes with it beside the
+        peg, near its top); a straight bridge over the peg from there can catch the nut on it.
+        """
+        if subtask == GRASP or not (self.nut_held() and self.nut_lifted()):
+            return None
+        bottom = self.data.xpos[self.bodies["nut"]][2] - NUT_HALF_THICKNESS
+        rise = PEG_TOP_Z + PEG_CLEARANCE - bottom
+        if rise <= 0:
+            return None
+        waypoint = self.eef_pose()
+        waypoint[2, 3] += rise
+        return waypoint
