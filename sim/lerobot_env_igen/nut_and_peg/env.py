@@ -14,9 +14,9 @@ nothing reveals it. 6-DOF delta-pose actions at 20 Hz, 400 steps.
   step; in the place, the held nut standing still in the air off the peg (it moved less than
   ``STALL_MOVE`` over the last ``STALL_STEPS`` steps, all of them held, lifted and more than
   ``STALL_OFF_AXIS`` from the peg's axis), what an operator watching a frozen arm reacts to.
-  Measured with the table's base policy (``benchmarks/nut_and_peg_ends.py``): after a regrasp on
-  geometry 2 it freezes 51-83 mm off the axis; a place that succeeds slows down to align only over
-  the peg, within 16 mm of its axis.
+  Measured with the table's base policy (``benchmarks/nut_and_peg_ends.py``, docs/benchmarks.md):
+  after a regrasp on geometry 2 it freezes 24-105 mm off the axis; a place that succeeds slows down
+  only over the peg, within 13 mm of its axis.
 * Subtask progress: 0 while the nut lies on the table, 1 once both finger pads hold it and while it
   is held, in the air or on the peg (dropped back on the table: 0, to be grasped again), 2 on success.
 * Success: robosuite's ``on_peg`` **and released** (no finger touches the nut).
@@ -188,7 +188,7 @@ class NutAndPegEnv(PandaTaskEnv):
         Of the nut's quarter turns about its axis, the one that keeps the wrist farthest inside its range:
         the square nut fits the square peg under any quarter turn about its axis. A policy that stalled has
         left the wrist wherever it did; the half turn of the hand that keeps the nut on the source's side drove
-        the wrist (joint 7) to its limit in 15 of 33 failed replays (``benchmarks/nut_and_peg_ends.py``). The
+        the wrist (joint 7) to its limit in 28 of 61 failed attempts (``benchmarks/nut_and_peg_ends.py``). The
         wrist turns opposite to the hand's heading (the hand points down) and takes the short way to each goal.
         """
         T_world_eef = self.eef_pose()
