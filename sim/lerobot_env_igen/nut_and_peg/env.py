@@ -118,7 +118,7 @@ class NutAndPegEnv(PandaTaskEnv):
 
     def _place_stalled(self) -> bool:
         """The held nut has stood still in the air off the peg for ``STALL_STEPS`` steps (once per stall)."""
-        if not (self.nut_held() and self.nut_lifted() and self.nut_off_axis() > STALL_OFF_AXIS):
+        if not (self.nut_held_in_the_air() and self.nut_off_axis() > STALL_OFF_AXIS):
             self._stall_track.clear()
             return False
         self._stall_track.append(self.data.xpos[self.bodies["nut"]].copy())
@@ -128,6 +128,10 @@ class NutAndPegEnv(PandaTaskEnv):
             return False
         self._stall_track.clear()  # fired: another stall needs a full window of its own
         return True
+
+    def nut_held_in_the_air(self) -> bool:
+        """Both pads hold the nut off the table: where a place can stall and a replayed place starts from."""
+        return self.nut_held() and self.nut_lifted()
 
     def nut_lifted(self) -> bool:
         """The nut is off the table: in the air or resting on the peg (not where the grasp starts again)."""
@@ -169,7 +173,7 @@ class NutAndPegEnv(PandaTaskEnv):
         arrives where the source's did. Place with the nut already in the air (a stalled place): see
         :meth:`_stalled_place_goals`.
         """
-        if subtask != GRASP and self.nut_held() and self.nut_lifted():
+        if subtask != GRASP and self.nut_held_in_the_air():
             return self._stalled_place_goals(goals, T_src_world_objects["nut"], T_src_world_eef)
         turned = goals.copy()
         turned[:, :3, :3] = goals[:, :3, :3] @ HALF_TURN
@@ -211,7 +215,7 @@ class NutAndPegEnv(PandaTaskEnv):
         For a place replayed with the nut in the air (a stalled place: the policy freezes with it beside the
         peg, near its top); a straight bridge over the peg from there can catch the nut on it.
         """
-        if subtask == GRASP or not (self.nut_held() and self.nut_lifted()):
+        if subtask == GRASP or not self.nut_held_in_the_air():
             return None
         bottom = self.data.xpos[self.bodies["nut"]][2] - NUT_HALF_THICKNESS
         rise = PEG_TOP_Z + PEG_CLEARANCE - bottom
